@@ -36,7 +36,7 @@ import yaml
 
 WRIST_JOINTS = ["wrist_tx", "wrist_ty", "wrist_tz", "wrist_rx", "wrist_ry", "wrist_rz"]
 HAND_FRAME_LINK = "hand_frame"
-CONFIG_DIR = Path(__file__).resolve().parent.parent / "configs"
+from unicross.config import CONFIG_DIR
 
 
 def cache_dir() -> Path:

@@ -68,3 +68,23 @@ def test_euler_roundtrip_and_slerp():
     assert torch.allclose(quat_to_euler_xyz(q), e, atol=1e-5)
     q2 = slerp_toward(q[1:], q[:1], 0.1)
     assert torch.allclose(quat_angle(q[1:], q2), torch.tensor([0.1]), atol=1e-5)
+
+
+def test_lean_quaternion_ops_match_reference():
+    from mani_skill.utils.geometry import rotation_conversions as rc
+    from unicross.geometry import quat_apply, quat_from_axis_angle, quat_inv, quat_mul, quat_to_axis_angle
+    g = torch.Generator().manual_seed(0)
+    q1 = torch.randn(64, 4, generator=g)
+    q1 = q1 / q1.norm(dim=-1, keepdim=True)
+    q2 = torch.randn(64, 4, generator=g)
+    q2 = q2 / q2.norm(dim=-1, keepdim=True)
+    v = torch.randn(64, 3, generator=g)
+    assert torch.allclose(quat_mul(q1, q2), rc.quaternion_raw_multiply(q1, q2), atol=1e-6)
+    assert torch.allclose(quat_apply(q1, v), rc.quaternion_apply(q1, v), atol=1e-5)
+    assert torch.allclose(quat_mul(q1, quat_inv(q1))[:, 0], torch.ones(64), atol=1e-6)
+    rv = rc.quaternion_to_axis_angle(rc.standardize_quaternion(q1))
+    assert torch.allclose(quat_to_axis_angle(q1), rv, atol=1e-4)
+    axis = torch.nn.functional.normalize(torch.randn(64, 3, generator=g), dim=-1)
+    ang = torch.rand(64, generator=g) * 3
+    assert torch.allclose(quat_from_axis_angle(axis, ang), rc.axis_angle_to_quaternion(axis * ang[:, None]), atol=1e-6)
+    assert torch.allclose(quat_angle(q1, quat_mul(quat_from_axis_angle(axis, ang), q1)), ang, atol=1e-4)

@@ -10,13 +10,9 @@ import math
 
 import torch
 from mani_skill.utils.geometry.rotation_conversions import (
-    axis_angle_to_quaternion,
     euler_angles_to_matrix,
     matrix_to_euler_angles,
     matrix_to_quaternion,
-    quaternion_apply,
-    quaternion_invert,
-    quaternion_multiply,
     quaternion_to_matrix,
 )
 
@@ -29,15 +25,45 @@ __all__ = [
     "closest_point_shapes",
 ]
 
-quat_mul = quaternion_multiply
-quat_inv = quaternion_invert
-quat_apply = quaternion_apply
+# Lean quaternion ops: few torch calls each (per-op dispatch dominates at small batch sizes).
+_LMAT_IDX = torch.tensor([[0, 1, 2, 3], [1, 0, 3, 2], [2, 3, 0, 1], [3, 2, 1, 0]])
+_LMAT_SIGN = torch.tensor([[1.0, -1.0, -1.0, -1.0], [1.0, 1.0, -1.0, 1.0], [1.0, 1.0, 1.0, -1.0], [1.0, -1.0, 1.0, 1.0]])
+_CONJ = torch.tensor([1.0, -1.0, -1.0, -1.0])
+_CACHE: dict = {}
+
+
+def _const(t: torch.Tensor, like: torch.Tensor) -> torch.Tensor:
+    key = (id(t), like.device, like.dtype)
+    c = _CACHE.get(key)
+    if c is None:
+        c = _CACHE[key] = t.to(device=like.device, dtype=like.dtype if t.is_floating_point() else t.dtype)
+    return c
+
+
+def quat_mul(q1: torch.Tensor, q2: torch.Tensor) -> torch.Tensor:
+    """Hamilton product q1 ⊗ q2 (wxyz), as one matrix-vector product."""
+    L = q1[..., _const(_LMAT_IDX, q1)] * _const(_LMAT_SIGN, q1)
+    return (L @ q2.unsqueeze(-1)).squeeze(-1)
+
+
+def quat_inv(q: torch.Tensor) -> torch.Tensor:
+    """Inverse of a unit quaternion (its conjugate)."""
+    return q * _const(_CONJ, q)
+
+
+def quat_apply(q: torch.Tensor, v: torch.Tensor) -> torch.Tensor:
+    """Rotate vectors v [..., 3] by unit quaternions q [..., 4]."""
+    u, w = q[..., 1:], q[..., :1]
+    t = 2.0 * torch.linalg.cross(u, v, dim=-1)
+    return v + w * t + torch.linalg.cross(u, t, dim=-1)
+
+
 quat_to_matrix = quaternion_to_matrix
 
 
 def quat_positive(q: torch.Tensor) -> torch.Tensor:
     """Canonical sign (w >= 0) so that q and -q map to the same numbers."""
-    return torch.where(q[..., :1] < 0, -q, q)
+    return q * torch.where(q[..., :1] < 0, -1.0, 1.0)
 
 
 def quat_from_matrix(m: torch.Tensor) -> torch.Tensor:
@@ -55,23 +81,24 @@ def quat_to_euler_xyz(q: torch.Tensor) -> torch.Tensor:
 
 def quat_from_axis_angle(axis: torch.Tensor, angle: torch.Tensor) -> torch.Tensor:
     """Rotation of ``angle`` (rad, shape [...]) about unit ``axis`` (shape [..., 3])."""
-    return axis_angle_to_quaternion(axis * angle.unsqueeze(-1))
+    half = 0.5 * angle.unsqueeze(-1)
+    return torch.cat([torch.cos(half), axis * torch.sin(half)], dim=-1)
 
 
 def quat_to_axis_angle(q: torch.Tensor) -> torch.Tensor:
-    """Rotation vector (axis * angle, angle in [0, pi]) of a quaternion; robust near identity."""
+    """Rotation vector (axis * angle, angle in [0, pi]) of a unit quaternion; robust near identity."""
     q = quat_positive(q)
-    v = q[..., 1:]
+    v, w = q[..., 1:], q[..., :1]
     s = torch.linalg.norm(v, dim=-1, keepdim=True)
-    angle = 2.0 * torch.atan2(s, q[..., :1])
-    scale = torch.where(s > 1e-8, angle / s.clamp_min(1e-12), 2.0 / q[..., :1].clamp_min(1e-12))
-    return v * scale
+    angle = 2.0 * torch.atan2(s, w)
+    # angle / s -> 2 / w as s -> 0
+    return v * torch.where(s > 1e-7, angle / s.clamp_min(1e-12), 2.0 / w.clamp_min(1e-12))
 
 
 def quat_angle(q1: torch.Tensor, q2: torch.Tensor) -> torch.Tensor:
-    """Angle (rad, in [0, pi]) of the rotation taking q1 to q2."""
-    d = torch.abs(torch.sum(q1 * q2, dim=-1)).clamp(max=1.0)
-    return 2.0 * torch.acos(d)
+    """Angle (rad, in [0, pi]) of the rotation taking q1 to q2 (atan2 form: exact near 0)."""
+    d = quat_mul(q2, quat_inv(q1))
+    return 2.0 * torch.atan2(torch.linalg.norm(d[..., 1:], dim=-1), d[..., 0].abs())
 
 
 def pose_mul(p1, q1, p2, q2):
@@ -95,8 +122,9 @@ def slerp_toward(q_from: torch.Tensor, q_to: torch.Tensor, max_angle: float | to
     dq = quat_mul(q_to, quat_inv(q_from))
     rv = quat_to_axis_angle(dq)
     angle = torch.linalg.norm(rv, dim=-1, keepdim=True)
-    rv = rv * torch.clamp(max_angle / angle.clamp_min(1e-9), max=1.0)
-    return quat_positive(quat_mul(axis_angle_to_quaternion(rv), q_from))
+    frac = torch.clamp(max_angle / angle.clamp_min(1e-9), max=1.0)
+    step = quat_from_axis_angle(rv / angle.clamp_min(1e-9), (angle * frac).squeeze(-1))
+    return quat_positive(quat_mul(step, q_from))
 
 
 # ----------------------------------------------------------------------------- closest points

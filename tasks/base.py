@@ -1,0 +1,571 @@
+"""One ManiSkill task class for all UniCross skills; skills differ only by data (their mode).
+
+The class owns the scene (table, floating hand, one object per parallel env), the per-step
+measurements, the relational targets, observation, reward and ``evaluate()``. Skill classes in
+``tasks/skills.py`` only choose modes and default object sets.
+
+Per control step (``step``):
+  1. the normalised action is mapped to joint targets with the current targets (formulation);
+  2. physics runs 6 substeps (120 Hz sim, 20 Hz control) with the object perturbation force;
+  3. ``evaluate()`` measures poses, contacts and distances once, computes the reward terms
+     against the targets the action aimed at, then advances the targets (Tracked rules) and
+     the accumulated rotation/translation. Observation and reward reuse this one evaluation.
+"""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any, Dict, Optional, Sequence
+
+import numpy as np
+import sapien
+import torch
+from gymnasium import spaces
+from gymnasium.vector.utils import batch_space
+from mani_skill.envs.sapien_env import BaseEnv
+from mani_skill.utils import common
+from mani_skill.utils.structs.actor import Actor
+from mani_skill.utils.structs.pose import Pose
+from mani_skill.utils.structs.types import SimConfig
+
+from unicross import formulation as F
+from unicross.config import load_config
+from unicross.geometry import (
+    closest_point_shapes, pose_mul, quat_apply, quat_from_axis_angle, quat_from_euler_xyz, quat_from_matrix,
+    quat_angle, quat_inv, quat_mul, quat_positive, relative_pose,
+)
+from unicross.grasps import GraspSet, default_grasp_path
+from unicross.objects import ObjectSpec, resolve_objects
+from unicross.rewards import RewardTerms
+from unicross.robots.hand import HAND_FRAME_LINK, HandSpec, load_hand, register_hand_agent
+from unicross.sensing import HandObjectSensor
+
+CATEGORY_ID = {"wrappable": 0, "elongated": 1}
+MODE_CATEGORIES = {"grasp": ("wrappable", "elongated"), "relocate": ("wrappable", "elongated"),
+                   "rotate": ("wrappable",), "translate": ("elongated",)}
+
+
+def _random_quaternion(n: int, gen: torch.Generator, device) -> torch.Tensor:
+    q = torch.randn(n, 4, generator=gen, device=device)
+    return quat_positive(q / torch.linalg.norm(q, dim=-1, keepdim=True))
+
+
+class UniCrossEnv(BaseEnv):
+    """**Task Description:** a floating dexterous hand performs one of ten relational modes
+    (grasp, relocate, rotate about ±x/±y/±z of the hand frame, translate along ±z of the hand
+    frame) on a rigid object; all modes share observation, action and reward structure.
+
+    **Randomizations:** object per env (from an object set), its mass U[0.002, 0.04] kg and the
+    hand/object friction U[0.3, 3.0] (drawn when the scene is built), the object's table pose and
+    the hand yaw (grasp), the grasp state, world wrist orientation and relocation target
+    (relocate/rotate/translate), joint-observation noise U(-0.02, 0.02) rad and a decaying random
+    perturbation force on the object.
+
+    **Success Conditions:** grasp: object lifted >= 5 cm during the lift phase and never dropped;
+    relocate: within 3 cm and 0.15 rad of the final pose, never dropped; rotate: accumulated
+    rotation about the axis > pi/2, never dropped; translate: accumulated translation along the
+    axis > 5 cm, never dropped. The episode terminates when the object drops.
+    """
+
+    SUPPORTED_OBS_MODES = ("state", "state_dict", "none")
+    SUPPORTED_REWARD_MODES = ("dense", "sparse", "none")
+    DEFAULT_OBJECTS = "train"
+    DEFAULT_MODES: Sequence[str] = F.MODES
+
+    def __init__(self, *args, hand: str = "allegro", objects=None, object_limit: Optional[int] = None,
+                 modes: Optional[Sequence[str]] = None, grasp_dataset: Optional[str] = None,
+                 config: Optional[dict] = None, reward_config: Optional[dict] = None,
+                 randomize: Optional[bool] = None, robot_uids=None, **kwargs):
+        # ---- validate everything before any simulation starts
+        self.hand_spec: HandSpec = load_hand(hand)
+        self.cfg = load_config("task", config)
+        if randomize is not None:
+            self.cfg["randomization"]["enabled"] = bool(randomize)
+        self.reward_cfg = load_config("reward", reward_config)
+        modes = tuple(modes or self.DEFAULT_MODES)
+        bad = [m for m in modes if m not in F.MODES]
+        if bad:
+            raise ValueError(f"unknown mode(s) {bad}; valid modes: {list(F.MODES)}")
+        objs = resolve_objects(self.DEFAULT_OBJECTS if objects is None else objects)
+        if isinstance(objects, str) or objects is None:
+            name = self.DEFAULT_OBJECTS if objects is None else objects
+            if object_limit is not None:
+                from unicross.objects import get_object_set
+                objs = get_object_set(name, limit=object_limit)
+        objs = [o.scaled(self.hand_spec.object_scale) for o in objs]
+        self.object_specs = objs
+        # valid (object, mode) pairs: rotate needs wrappable, translate elongated objects
+        self._pairs = [(oi, F.MODES.index(m)) for oi, o in enumerate(objs) for m in modes
+                       if o.category in MODE_CATEGORIES[F.mode_skill(m)]]
+        if not self._pairs:
+            raise ValueError(f"no object of the given set fits modes {list(modes)} "
+                             f"(rotate needs wrappable objects, translate elongated ones)")
+        self.modes_used = modes
+        skills = {F.mode_skill(m) for m in modes}
+        self.static_skill = skills.pop() if len(skills) == 1 else None  # lets target updates skip other rules
+        self.grasps: Optional[GraspSet] = None
+        if any(F.mode_skill(m) != "grasp" for m in modes):
+            path = grasp_dataset or default_grasp_path(self.hand_spec.name)
+            self.grasps = GraspSet.load(path)
+            if self.grasps.hand != self.hand_spec.name:
+                raise ValueError(f"grasp dataset {path} is for hand {self.grasps.hand!r}, not {self.hand_spec.name!r}")
+            needed = {objs[oi].name for oi, mi in self._pairs if F.mode_skill(F.MODES[mi]) != "grasp"}
+            missing = sorted(needed - set(self.grasps.object_names))
+            if missing:
+                raise ValueError(f"grasp dataset {path} has no grasps for {len(missing)} object(s), e.g. "
+                                 f"{missing[:3]}; build them with `unicross grasps --objects <set>`")
+        register_hand_agent(self.hand_spec)
+        super().__init__(*args, robot_uids=self.hand_spec.uid, **kwargs)
+        n = self.hand_spec.dof
+        self.single_action_space = spaces.Box(-1.0, 1.0, (n,), dtype=np.float32)
+        self.action_space = batch_space(self.single_action_space, self.num_envs)
+
+    # ------------------------------------------------------------------ configuration
+    @property
+    def _default_sim_config(self):
+        s = self.cfg["sim"]
+        return SimConfig(sim_freq=s["sim_freq"], control_freq=s["control_freq"],
+                         scene_config=dict(contact_offset=s["contact_offset"],
+                                           solver_position_iterations=s["solver_position_iterations"],
+                                           solver_velocity_iterations=s["solver_velocity_iterations"]))
+
+    @property
+    def control_dt(self) -> float:
+        return 1.0 / self._control_freq
+
+    def _load_agent(self, options: dict):
+        super()._load_agent(options, sapien.Pose(p=[0.0, 0.0, 1.0]))
+
+    # ------------------------------------------------------------------ scene
+    def _load_scene(self, options: dict):
+        can_render = self.scene.can_render()
+        if self.cfg["table"]:
+            b = self.scene.create_actor_builder()
+            b.add_box_collision(half_size=[0.6, 0.6, 0.025])
+            if can_render:
+                b.add_box_visual(half_size=[0.6, 0.6, 0.025],
+                                 material=sapien.render.RenderMaterial(base_color=[0.6, 0.5, 0.4, 1]))
+            b.initial_pose = sapien.Pose(p=[0, 0, -0.025])
+            self.table = b.build_static(name="table")
+        rng = self._batched_episode_rng[0]
+        start = int(rng.randint(len(self._pairs)))
+        pairs = [self._pairs[(start + i) % len(self._pairs)] for i in range(self.num_envs)]
+        rcfg = self.cfg["randomization"]
+        dr = rcfg["enabled"]
+        masses = rng.uniform(*rcfg["mass"], size=self.num_envs) if dr else np.full(self.num_envs, 0.02)
+        frictions = rng.uniform(*rcfg["friction"], size=self.num_envs) if dr else np.full(self.num_envs, 1.0)
+        actors = []
+        for i, (oi, _) in enumerate(pairs):
+            spec = self.object_specs[oi]
+            mat = sapien.physx.PhysxMaterial(float(frictions[i]), float(frictions[i]), 0.0)
+            b = self.scene.create_actor_builder()
+            spec.add_to_builder(b, density=float(masses[i]) / spec.volume(), material=mat, can_render=can_render)
+            b.set_scene_idxs([i])
+            b.initial_pose = sapien.Pose(p=[0.3 * i, 0, 0.5])
+            actors.append(b.build(name=f"object-{i}"))
+            for link in self.agent.robot.links:  # friction applies to hand and object alike
+                for shape in link._objs[i].collision_shapes:
+                    shape.physical_material = mat
+        self.obj = Actor.merge(actors, name="object")
+        dev = self.device
+        self.obj_index = torch.tensor([p[0] for p in pairs], device=dev)
+        self.mode = torch.tensor([p[1] for p in pairs], device=dev)
+        self.obj_mass = torch.tensor(masses, dtype=torch.float32, device=dev)
+        self.obj_friction = torch.tensor(frictions, dtype=torch.float32, device=dev)
+        specs = [self.object_specs[p[0]] for p in pairs]
+        self.env_objects = specs
+        self.obj_shape = torch.tensor([s.shape_type for s in specs], device=dev)
+        self.obj_params = torch.tensor(np.stack([s.params for s in specs]), device=dev)
+        self.obj_category = torch.tensor([CATEGORY_ID[s.category] for s in specs], device=dev)
+        self.obj_rest_height = torch.tensor([[s.half_height_on_table(False), s.half_height_on_table(True)]
+                                             for s in specs], dtype=torch.float32, device=dev)
+        self.obj_can_stand = torch.tensor([s.category == "wrappable" and s.shape != "sphere" for s in specs], device=dev)
+        meshes = [s for s in specs if s.shape == "mesh"]
+        self.obj_tris = None
+        if meshes:
+            tri = [np.asarray(s.trimesh().triangles, dtype=np.float32) if s.shape == "mesh"
+                   else np.zeros((1, 3, 3), np.float32) for s in specs]
+            fmax = max(len(t) for t in tri)
+            tri = [np.concatenate([t, np.repeat(t[:1], fmax - len(t), 0)]) for t in tri]
+            self.obj_tris = torch.tensor(np.stack(tri), device=dev)
+
+    def _after_reconfigure(self, options: dict):
+        spec, robot, dev = self.hand_spec, self.agent.robot, self.device
+        names = [j.name for j in robot.active_joints]
+        self._qidx = torch.tensor([names.index(j) for j in spec.joint_names], device=dev)
+        lim = robot.get_qlimits()[0].to(dev)[self._qidx]
+        self.q_lower, self.q_upper = lim[:, 0].clone(), lim[:, 1].clone()
+        self.action_scale = torch.tensor(spec.action_scales(), device=dev)
+        links = {l.name: l for l in robot.links}
+        missing = [n for n in spec.contact_links if n not in links]
+        if missing:
+            raise ValueError(f"hand {spec.name!r}: contact links {missing} not in the URDF")
+        self.contact_links = [links[n] for n in spec.contact_links]
+        probe = []
+        for l in self.contact_links:  # distance vectors start at the centre of the link's collision shapes
+            shapes = l._objs[0].collision_shapes
+            probe.append(np.mean([s.local_pose.p for s in shapes], axis=0) if shapes else np.zeros(3))
+        self.link_probe = torch.tensor(np.array(probe), dtype=torch.float32, device=dev)
+        self.sensor = HandObjectSensor(self.scene, links[HAND_FRAME_LINK], self.contact_links, self.obj)
+        pd = spec.pd["finger"]
+        self._finger_pd = (pd["stiffness"], pd["damping"], pd["force_limit"])
+        self.episode_length = torch.tensor([self.cfg["episode_length"][F.mode_skill(m)] for m in F.MODES], device=dev)
+        self.rewards = RewardTerms(self.reward_cfg, dev, self.cfg["ablation"]["no_track_reward"])
+        self.motion = F.MotionParams(dt=self.control_dt, **self.cfg["motion"])
+        self._speed_cap = torch.tensor([self.cfg["motion"]["omega_max"] if F.mode_skill(m) == "rotate"
+                                        else self.cfg["motion"]["v_max"] for m in F.MODES], device=dev)
+        self._alloc_buffers()
+
+    def _alloc_buffers(self):
+        n, dev, dof = self.num_envs, self.device, self.hand_spec.dof
+        z3, z4 = torch.zeros(n, 3, device=dev), torch.zeros(n, 4, device=dev)
+        ident = z4.clone()
+        ident[:, 0] = 1
+        rel = lambda: F.Relational(z3.clone(), ident.clone(), z3.clone(), ident.clone(), z3.clone(), ident.clone())
+        self.root_p, self.root_q = z3.clone(), ident.clone()
+        self.init_rel, self.targets, self.prev_rel, self.cur_rel = rel(), rel(), rel(), rel()
+        self.final_x_or, self.final_q_or = z3.clone(), ident.clone()
+        self.axis = z3.clone()
+        self.command = torch.zeros(n, dof, device=dev)
+        self.finger_q0 = torch.zeros(n, dof - 6, device=dev)
+        self.rot_acc = torch.zeros(n, device=dev)
+        self.trans_acc = torch.zeros(n, device=dev)
+        self.ever_dropped = torch.zeros(n, dtype=torch.bool, device=dev)
+        self.obj_z0 = torch.zeros(n, device=dev)
+        self.lift = z3.clone()
+        self.perturb = z3.clone()
+        self.obs_noise = torch.zeros(n, dof, device=dev)
+        self.obj_vel_h = z3.clone()
+        self.obj_angvel_h = z3.clone()
+        self.hand_vel = z3.clone()
+        self.hand_angvel = z3.clone()
+        self._pending = torch.zeros(n, dtype=torch.bool, device=dev)
+        self._gen = torch.Generator(device=dev)
+        self._gen.manual_seed(int(self._episode_seed[0]))
+
+    # ------------------------------------------------------------------ episode start
+    def _initialize_episode(self, env_idx: torch.Tensor, options: dict):
+        dev, spec = self.device, self.hand_spec
+        b = len(env_idx)
+        if options.get("seed_generator", True) and self._episode_seed is not None:
+            self._gen.manual_seed(int(self._episode_seed[0]))
+        g = self._gen
+        mode = self.mode[env_idx]
+        skill = F.MODE_SKILL_ID.to(dev)[mode]
+        cat = self.obj_category[env_idx]
+        # ---- grasp start: object resting on the table, hand top-down, fingers spread (theta0/theta1)
+        upright = (torch.rand(b, generator=g, device=dev) < 0.5) & self.obj_can_stand[env_idx]
+        h = torch.where(upright, self.obj_rest_height[env_idx, 1], self.obj_rest_height[env_idx, 0])
+        yaw = torch.rand(b, generator=g, device=dev) * 2 * math.pi
+        zaxis = torch.tensor([0.0, 0.0, 1.0], device=dev).expand(b, 3)
+        q_yaw = quat_from_axis_angle(zaxis, yaw)
+        stand = quat_from_axis_angle(torch.tensor([0.0, 1.0, 0.0], device=dev).expand(b, 3),
+                                     torch.full((b,), -math.pi / 2, device=dev))
+        obj_q_table = torch.where(upright[:, None], quat_mul(q_yaw, stand), q_yaw)
+        r = self.cfg["grasp"]["xy_range"]
+        xy = (torch.rand(b, 2, generator=g, device=dev) * 2 - 1) * r
+        obj_p_table = torch.cat([xy, h[:, None]], dim=-1)
+        # hand: palm normal (+x_h) down; fingers (+z_h) along the object's long axis when elongated
+        flip = (torch.rand(b, generator=g, device=dev) < 0.5).float() * math.pi
+        hand_yaw = torch.where(cat == CATEGORY_ID["elongated"], yaw + flip,
+                               torch.rand(b, generator=g, device=dev) * 2 * math.pi)
+        xh = torch.tensor([0.0, 0.0, -1.0], device=dev).expand(b, 3)
+        zh = torch.stack([torch.cos(hand_yaw), torch.sin(hand_yaw), torch.zeros_like(hand_yaw)], -1)
+        yh = torch.cross(zh, xh, dim=-1)
+        hand_q_grasp = quat_from_matrix(torch.stack([xh, yh, zh], dim=-1))
+        hand_p_grasp = obj_p_table.clone()
+        hand_p_grasp[:, 2] = 2 * h + self.cfg["grasp"]["hover"]
+        init_pose = torch.stack([torch.tensor(spec.init_finger_qpos(c), device=dev) for c in ("wrappable", "elongated")])
+        fq_grasp = init_pose[cat]
+        # ---- in-hand start (relocate / rotate / translate): a grasp state from the dataset
+        hand_p, hand_q, obj_p, obj_q = hand_p_grasp, hand_q_grasp, obj_p_table, obj_q_table
+        fq, ft = fq_grasp, fq_grasp
+        if self.grasps is not None:
+            gs = self.grasps.sample(self.obj_index[env_idx], [o.name for o in self.object_specs], g)
+            random_q = _random_quaternion(b, g, dev)
+            world_q = torch.where((skill == F.SKILLS.index("relocate"))[:, None], gs["wrist_pose"][:, 3:], random_q)
+            world_p = gs["wrist_pose"][:, :3].clone()
+            inhand_h = self.cfg["in_hand_start_height"]
+            world_p = torch.where((skill == F.SKILLS.index("relocate"))[:, None], world_p,
+                                  torch.tensor([0.0, 0.0, inhand_h], device=dev).expand(b, 3))
+            op, oq = pose_mul(world_p, world_q, gs["object_pose_hand"][:, :3], gs["object_pose_hand"][:, 3:])
+            is_grasp = (skill == 0)[:, None]
+            hand_p = torch.where(is_grasp, hand_p, world_p)
+            hand_q = torch.where(is_grasp, hand_q, world_q)
+            obj_p = torch.where(is_grasp, obj_p, op)
+            obj_q = torch.where(is_grasp, obj_q, oq)
+            fq = torch.where(is_grasp, fq, gs["finger_qpos"])
+            ft = torch.where(is_grasp, ft, gs["finger_target"])
+        # ---- apply to the simulation
+        qpos = torch.zeros(b, spec.dof, device=dev)
+        qpos[:, 6:] = fq
+        art_q = torch.zeros_like(qpos)
+        art_q[:, self._qidx] = qpos
+        self.agent.robot.set_qpos(art_q)
+        self.agent.robot.set_qvel(torch.zeros_like(art_q))
+        self.agent.robot.set_root_pose(Pose.create_from_pq(hand_p, hand_q))
+        self.obj.set_pose(Pose.create_from_pq(obj_p, obj_q))
+        # ---- task state
+        self.root_p[env_idx], self.root_q[env_idx] = hand_p, hand_q
+        xo, qo = relative_pose(hand_p, hand_q, obj_p, obj_q)
+        ident = torch.zeros(b, 4, device=dev)
+        ident[:, 0] = 1
+        init = F.Relational(xo, qo, xo.clone(), qo.clone(), torch.zeros_like(xo), ident)
+        self.init_rel.assign(init, env_idx)
+        self.targets.assign(init, env_idx)
+        self.prev_rel.assign(init, env_idx)
+        self.cur_rel.assign(init, env_idx)
+        # relocate: final object pose = start + world offsets (x, y, z; roll, pitch, yaw)
+        rt = self.cfg["relocate_target"]
+        off = torch.rand(b, 3, generator=g, device=dev)
+        off = torch.stack([(off[:, 0] * 2 - 1) * rt["xy"], (off[:, 1] * 2 - 1) * rt["xy"],
+                           rt["z"][0] + off[:, 2] * (rt["z"][1] - rt["z"][0])], -1)
+        rpy = (torch.rand(b, 3, generator=g, device=dev) * 2 - 1) * rt["rpy"]
+        fp, fqw = obj_p + off, quat_positive(quat_mul(quat_from_euler_xyz(rpy), obj_q))
+        fx, fqr = relative_pose(hand_p, hand_q, fp, fqw)
+        is_reloc = (skill == F.SKILLS.index("relocate"))[:, None]
+        self.final_x_or[env_idx] = torch.where(is_reloc, fx, xo)
+        self.final_q_or[env_idx] = torch.where(is_reloc, fqr, qo)
+        cmd = torch.zeros(b, spec.dof, device=dev)
+        cmd[:, 6:] = ft
+        self.command[env_idx] = cmd
+        self.finger_q0[env_idx] = fq
+        self.rot_acc[env_idx] = 0
+        self.trans_acc[env_idx] = 0
+        self.ever_dropped[env_idx] = False
+        self.obj_z0[env_idx] = obj_p[:, 2]
+        self.lift[env_idx] = 0
+        self.perturb[env_idx] = 0
+        for t in (self.obj_vel_h, self.obj_angvel_h, self.hand_vel, self.hand_angvel):
+            t[env_idx] = 0
+        self._pending[env_idx] = True
+
+    def reset(self, seed=None, options=None):
+        obs, info = super().reset(seed=seed, options=options)
+        # finger drive targets of a restored grasp (the controller reset set them to qpos)
+        self._apply_command()
+        return obs, info
+
+    def _apply_command(self):
+        self.agent.controller.set_drive_targets(self.command)
+        if self.gpu_sim_enabled:
+            self.scene.px.gpu_apply_articulation_target_position()
+
+    # ------------------------------------------------------------------ stepping
+    def step(self, action):
+        a = common.to_tensor(action, device=self.device)
+        if a.ndim == 1:
+            a = a[None]
+        if a.shape != (self.num_envs, self.hand_spec.dof):
+            raise ValueError(f"action must have shape ({self.num_envs}, {self.hand_spec.dof}), got {tuple(a.shape)}")
+        a = a.float()
+        if not torch.isfinite(a).all():
+            raise ValueError("action contains NaN or inf")
+        a = a.clamp(-1.0, 1.0)
+        self._advance_lift()
+        ref = F.wrist_reference(self.targets)
+        ref[:, :3] = ref[:, :3] + self.lift
+        self.command = F.map_action(a, self.command, ref, self.action_scale, self.q_lower, self.q_upper,
+                                    wrist_from_target=not self.cfg["ablation"]["no_target_action"])
+        obs, reward, _, _, info = super().step(self.command)
+        terminated = info["fail"].clone()
+        truncated = self.elapsed_steps >= self.episode_length[self.mode]
+        return obs, reward, terminated, truncated, info
+
+    def _advance_lift(self):
+        lift_after = self.cfg["grasp"]["lift_after"]
+        if lift_after is None:
+            return
+        lifting = (self.mode == 0) & (self.elapsed_steps >= lift_after)
+        up_root = quat_apply(quat_inv(self.root_q), torch.tensor([0.0, 0.0, 1.0], device=self.device).expand_as(self.lift))
+        self.lift = self.lift + lifting[:, None].float() * up_root * self.cfg["grasp"]["lift_speed"] * self.control_dt
+
+    def _before_simulation_step(self):
+        rc = self.cfg["randomization"]
+        if not rc["enabled"] or rc["perturb_scale"] == 0:
+            return
+        n = self.num_envs
+        new = rc["perturb_scale"] * self.obj_mass[:, None] * torch.randn(n, 3, generator=self._gen, device=self.device)
+        redraw = torch.rand(n, 1, generator=self._gen, device=self.device) < rc["perturb_prob"]
+        self.perturb = torch.where(redraw, new, self.perturb * rc["perturb_decay"])
+        self.sensor.apply_object_force(self.perturb)
+
+    # ------------------------------------------------------------------ evaluation (single source of truth)
+    def _measure(self) -> Dict[str, torch.Tensor]:
+        pos, quat = self.sensor.poses()
+        hand_p, hand_q = pos[:, 0], quat[:, 0]
+        link_p, link_q = pos[:, 1:-1], quat[:, 1:-1]
+        obj_p, obj_q = pos[:, -1], quat[:, -1]
+        L = link_p.shape[1]
+        probe_w = link_p + quat_apply(link_q, self.link_probe.expand(self.num_envs, L, 3))
+        inv_q = quat_inv(obj_q)[:, None].expand(-1, L, 4)
+        probe_o = quat_apply(inv_q, probe_w - obj_p[:, None])
+        closest_o = closest_point_shapes(probe_o, self.obj_shape, self.obj_params, self.obj_tris)
+        vec_w = quat_apply(obj_q[:, None].expand(-1, L, 4), closest_o - probe_o)  # link -> surface, world axes
+        vec_h = quat_apply(quat_inv(hand_q)[:, None].expand(-1, L, 4), vec_w)      # ... in the hand frame
+        force = torch.linalg.norm(self.sensor.contact_forces(), dim=-1)
+        robot = self.agent.robot
+        q = robot.get_qpos()[:, self._qidx]
+        qd = robot.get_qvel()[:, self._qidx]
+        kp, kd, fl = self._finger_pd
+        torque = torch.clamp(kp * (self.command[:, 6:] - q[:, 6:]) - kd * qd[:, 6:], -fl, fl)
+        return dict(hand_p=hand_p, hand_q=hand_q, obj_p=obj_p, obj_q=obj_q, link_vec=vec_h,
+                    link_distance=torch.linalg.norm(vec_h, dim=-1), force=force, qpos=q, finger_torque=torque)
+
+    def evaluate(self) -> dict:
+        m = self._measure()
+        cur = F.relational_poses(self.root_p, self.root_q, m["hand_p"], m["hand_q"], m["obj_p"], m["obj_q"])
+        pend = self._pending
+        # velocities and accumulated motion over the last control step
+        dt = self.control_dt
+        prev = self.prev_rel
+        v, w = F.finite_velocity(prev.x_oh, prev.q_oh, cur.x_oh, cur.q_oh, dt)
+        hv, hw = F.finite_velocity(prev.x_hr, prev.q_hr, cur.x_hr, cur.q_hr, dt)
+        p1 = pend[:, None]
+        self.obj_vel_h = torch.where(p1, v, self.obj_vel_h)
+        self.obj_angvel_h = torch.where(p1, w, self.obj_angvel_h)
+        self.hand_vel = torch.where(p1, hv, self.hand_vel)
+        self.hand_angvel = torch.where(p1, hw, self.hand_angvel)
+        skill = F.MODE_SKILL_ID.to(self.device)[self.mode]
+        is_rot = skill == F.SKILLS.index("rotate")
+        is_trans = skill == F.SKILLS.index("translate")
+        axis_prev = self.axis
+        self.rot_acc = self.rot_acc + (pend & is_rot).float() * (w * axis_prev).sum(-1) * dt
+        self.trans_acc = self.trans_acc + (pend & is_trans).float() * (v * axis_prev).sum(-1) * dt
+        # reward compares against the targets the last action aimed at; Free targets = current
+        reward_targets = F.with_free_as_current(self.mode, self.targets, cur)
+        # advance the targets
+        axis = F.task_axis(self.mode, cur, self.final_x_or)
+        init = self.init_rel.clone()
+        init.x_or = init.x_or + self.lift
+        new_t = F.update_targets(self.mode, cur, init, self.final_x_or, self.final_q_or, axis, self.motion,
+                                 skill=self.static_skill)
+        self.targets = new_t.where(pend, self.targets)
+        self.axis = torch.where(p1, axis, self.axis)
+        self.prev_rel = cur.where(pend, self.prev_rel)
+        self.cur_rel = cur
+        rc = self.cfg["randomization"]
+        if rc["enabled"] and rc["joint_obs_noise"] > 0:
+            noise = (torch.rand(self.obs_noise.shape, generator=self._gen, device=self.device) * 2 - 1) * rc["joint_obs_noise"]
+            self.obs_noise = torch.where(p1, noise, self.obs_noise)
+        self._pending = torch.zeros_like(pend)
+        # drop and success (DESIGN §6)
+        dist = m["link_distance"]
+        drop = dist.min(dim=-1).values > self.cfg["drop_threshold"]
+        self.ever_dropped = self.ever_dropped | drop
+        contact = m["force"] > self.cfg["contact_force_threshold"]
+        lifted = (m["obj_p"][:, 2] - self.obj_z0) > self.cfg["grasp"]["lift_success"]
+        fx, fq = pose_mul(self.root_p, self.root_q, self.final_x_or, self.final_q_or)
+        pos_err = torch.linalg.norm(m["obj_p"] - fx, dim=-1)
+        rot_err = quat_angle(m["obj_q"], fq)
+        sc = self.cfg["success"]
+        ok = ~self.ever_dropped
+        success_by_skill = torch.stack([
+            lifted & (contact.sum(-1) >= 2),
+            (pos_err < sc["relocate_pos"]) & (rot_err < sc["relocate_rot"]),
+            self.rot_acc > sc["rotate_angle"],
+            self.trans_acc > sc["translate_dist"],
+        ], dim=-1)
+        success = success_by_skill.gather(1, skill[:, None])[:, 0] & ok
+        # measurements for observation and reward
+        force_c = m["force"].clamp(max=self.cfg["force_clip"])
+        speed = torch.where(is_rot, (self.obj_angvel_h * self.axis).sum(-1), (self.obj_vel_h * self.axis).sum(-1))
+        meas = dict(link_distance=dist, contact=contact, force_clipped=force_c, speed_along_axis=speed,
+                    speed_cap=self._speed_cap[self.mode], relational=cur, reward_targets=reward_targets,
+                    finger_qpos=m["qpos"][:, 6:], finger_qpos0=self.finger_q0, hand_lin_vel=self.hand_vel,
+                    hand_ang_vel=self.hand_angvel, finger_torque=m["finger_torque"], drop=drop)
+        terms = self.rewards(self.mode, meas)
+        self._obs_parts = dict(qpos=m["qpos"], contact=contact, force=force_c, vec=m["link_vec"])
+        info = dict(success=success, fail=drop, drop=drop, ever_dropped=self.ever_dropped.clone(),
+                    lifted=lifted, relocate_pos_err=pos_err, relocate_rot_err=rot_err,
+                    rotation=self.rot_acc.clone(), translation=self.trans_acc.clone(),
+                    num_contacts=contact.sum(-1), mode=self.mode.clone())
+        info.update({f"reward_{k}": v for k, v in terms.items()})
+        return info
+
+    # ------------------------------------------------------------------ observation
+    def _get_obs_agent(self):
+        return dict()
+
+    def _get_obs_extra(self, info: dict):
+        p = self._obs_parts
+        ab = self.cfg["ablation"]
+        q = p["qpos"] + self.obs_noise
+        hand = torch.cat([q, self.command], dim=-1)
+        contact = p["contact"].float()
+        force = p["force"]
+        vec = p["vec"].reshape(self.num_envs, -1)
+        if ab["no_contact"]:
+            contact, force = torch.zeros_like(contact), torch.zeros_like(force)
+        if ab["no_distance"]:
+            vec = torch.zeros_like(vec)
+        goal = F.goal_features(self.mode, self.axis, self.cur_rel, self.targets, zero_target=ab["no_target_obs"])
+        return dict(hand=hand, object=dict(contact=contact, force=force, distance=vec), goal=goal)
+
+    # ------------------------------------------------------------------ reward
+    def compute_dense_reward(self, obs: Any, action: torch.Tensor, info: dict):
+        return sum(info[f"reward_{k}"] for k in ("contact", "motion", "track", "pose", "wrist_velocity", "energy", "drop"))
+
+    def compute_normalized_dense_reward(self, obs: Any, action: torch.Tensor, info: dict):
+        return self.compute_dense_reward(obs, action, info)
+
+    # ------------------------------------------------------------------ state (sim + task)
+    _TASK_STATE = ("root_p", "root_q", "init_rel", "targets", "prev_rel", "final_x_or", "final_q_or", "axis",
+                   "command", "finger_q0", "rot_acc", "trans_acc", "ever_dropped", "obj_z0", "lift", "perturb",
+                   "obs_noise", "obj_vel_h", "obj_angvel_h", "hand_vel", "hand_angvel", "mode")
+
+    def _task_state(self) -> Dict[str, torch.Tensor]:
+        out = {}
+        for k in self._TASK_STATE:
+            v = getattr(self, k)
+            if isinstance(v, F.Relational):
+                v = v.flat()
+            v = v.float()
+            out[k] = v[:, None] if v.ndim == 1 else v
+        return out
+
+    def get_state_dict(self):
+        state = super().get_state_dict()
+        state["task"] = self._task_state()
+        return state
+
+    def set_state_dict(self, state: dict, env_idx: torch.Tensor = None):
+        super().set_state_dict(state, env_idx)
+        task = state.get("task")
+        if task is None:
+            return
+        idx = slice(None) if env_idx is None else env_idx
+        for k in self._TASK_STATE:
+            cur = getattr(self, k)
+            v = common.to_tensor(task[k], device=self.device)
+            if isinstance(cur, F.Relational):
+                flat = cur.flat()
+                flat[idx] = v
+                setattr(self, k, F.Relational.unflat(flat).clone())
+            else:
+                v = v.reshape(v.shape[0], *cur.shape[1:]).to(cur.dtype)
+                cur[idx] = v
+        self._apply_command()
+        self._pending[idx] = False
+        # the observation reflects the restored state
+        self.evaluate()
+
+    def set_state(self, state, env_idx: torch.Tensor = None):
+        state = common.to_tensor(state, device=self.device)
+        if state.ndim == 1:
+            state = state[None]
+        sd: Dict[str, Any] = dict(actors={}, articulations={})
+        start = 0
+        for k in self._init_raw_state["actors"]:
+            sd["actors"][k] = state[:, start:start + 13]
+            start += 13
+        for k, v in self._init_raw_state["articulations"].items():
+            sd["articulations"][k] = state[:, start:start + v.shape[-1]]
+            start += v.shape[-1]
+        task = {}
+        for k, v in self._task_state().items():
+            task[k] = state[:, start:start + v.shape[-1]]
+            start += v.shape[-1]
+        if start == state.shape[-1]:
+            sd["task"] = task
+        self.set_state_dict(sd, env_idx)

@@ -1,0 +1,11 @@
+"""UniCross: unified cross-skill dexterous manipulation as ManiSkill3 tasks.
+
+``import unicross`` registers the task ids ``UniCross-{Grasp,Relocate,Rotate,Translate,MultiSkill}-v1``
+with gymnasium/ManiSkill.
+"""
+__version__ = "0.1.0"
+
+from unicross.tasks import skills as _skills  # noqa: F401  (registers the environments)
+
+TASK_IDS = ("UniCross-Grasp-v1", "UniCross-Relocate-v1", "UniCross-Rotate-v1", "UniCross-Translate-v1",
+            "UniCross-MultiSkill-v1")

@@ -1,0 +1,297 @@
+"""The hand-object relational formulation (paper §3.1-3.2, DESIGN §2), in one place.
+
+Frames
+    world; root r (the hand frame's world pose at episode start, fixed for the episode);
+    hand h (the current hand frame, origin at the palm point).
+Relational poses (``SLOTS``)
+    x_oh, q_oh  object in the hand frame      x_or, q_or  object in the root frame
+    x_hr, q_hr  hand in the root frame
+Targets
+    each slot's target is Tracked (updated every step by a named rule), Fixed (value at the
+    episode start) or Free (the current value, i.e. unconstrained). ``SKILL_TARGETS`` below is
+    the paper's Table 1 as data; the ten modes are instantiations of the four skills.
+Goal features
+    g = [one-hot mode (10), d^h (3), current poses (21), target poses (21)] = 55-D.
+Action
+    q_act = clamp(q_ref + alpha * a, q_min, q_max), q_ref = previous command for the fingers and
+    the current *target* wrist pose (x̂_h^r, Euler XYZ of q̂_h^r) for the six virtual joints.
+
+Everything is batched over environments: a ``mode`` tensor selects per-env rules.
+"""
+from __future__ import annotations
+
+import dataclasses
+from typing import Dict, List, Tuple
+
+import torch
+
+from unicross.geometry import (
+    pose_inv, pose_mul, quat_apply, quat_from_axis_angle, quat_inv, quat_mul, quat_positive,
+    quat_to_axis_angle, quat_to_euler_xyz, relative_pose, slerp_toward,
+)
+
+SKILLS = ("grasp", "relocate", "rotate", "translate")
+ROTATE_AXES = ("x+", "x-", "y+", "y-", "z+", "z-")
+TRANSLATE_DIRECTIONS = ("z+", "z-")
+MODES: Tuple[str, ...] = (("grasp", "relocate") + tuple(f"rotate_{a}" for a in ROTATE_AXES)
+                          + tuple(f"translate_{d}" for d in TRANSLATE_DIRECTIONS))
+NUM_MODES = len(MODES)  # 10
+SLOTS = ("x_oh", "q_oh", "x_or", "q_or", "x_hr", "q_hr")
+SLOT_DIMS = {"x_oh": 3, "q_oh": 4, "x_or": 3, "q_or": 4, "x_hr": 3, "q_hr": 4}
+GOAL_DIM = NUM_MODES + 3 + 2 * sum(SLOT_DIMS.values())  # 55
+
+TRACKED, FIXED, FREE = "Tracked", "Fixed", "Free"
+# Paper Table 1. Values are rule names: "fixed", "free" or a tracked rule (see _RULES).
+SKILL_TARGETS: Dict[str, Dict[str, str]] = {
+    "grasp": dict(x_oh="palm", q_oh="free", x_or="fixed", q_or="fixed", x_hr="free", q_hr="free"),
+    "relocate": dict(x_oh="fixed", q_oh="fixed", x_or="interpolate", q_or="interpolate",
+                     x_hr="hand_from_object", q_hr="hand_from_object"),
+    "rotate": dict(x_oh="fixed", q_oh="rotate_about_axis", x_or="fixed", q_or="object_from_hand",
+                   x_hr="fixed", q_hr="fixed"),
+    "translate": dict(x_oh="translate_along_axis", q_oh="fixed", x_or="object_from_hand", q_or="fixed",
+                      x_hr="fixed", q_hr="fixed"),
+}
+
+
+def target_kind(rule: str) -> str:
+    return FIXED if rule == "fixed" else FREE if rule == "free" else TRACKED
+
+
+def target_table() -> Dict[str, Dict[str, List[str]]]:
+    """Skill -> {Tracked: [...], Fixed: [...], Free: [...]} (the paper's Table 1)."""
+    return {s: {k: [slot for slot in SLOTS if target_kind(r[slot]) == k] for k in (TRACKED, FIXED, FREE)}
+            for s, r in SKILL_TARGETS.items()}
+
+
+def mode_skill(mode: str) -> str:
+    return mode.split("_")[0]
+
+
+def mode_index(skill: str, axis: str | None = None) -> int:
+    """Index into MODES of a skill (with its axis for rotate / direction for translate)."""
+    if skill not in SKILLS:
+        raise ValueError(f"unknown skill {skill!r}; valid skills: {list(SKILLS)}")
+    if skill == "rotate":
+        if axis not in ROTATE_AXES:
+            raise ValueError(f"invalid rotate axis {axis!r}; valid axes: {list(ROTATE_AXES)}")
+        return MODES.index(f"rotate_{axis}")
+    if skill == "translate":
+        if axis not in TRANSLATE_DIRECTIONS:
+            raise ValueError(f"invalid translate direction {axis!r}; valid directions: {list(TRANSLATE_DIRECTIONS)}")
+        return MODES.index(f"translate_{axis}")
+    if axis is not None:
+        raise ValueError(f"skill {skill!r} takes no axis/direction (got {axis!r})")
+    return MODES.index(skill)
+
+
+def _axis_vec(a: str) -> List[float]:
+    v = [0.0, 0.0, 0.0]
+    v["xyz".index(a[0])] = 1.0 if a[1] == "+" else -1.0
+    return v
+
+
+MODE_AXES = torch.tensor([[0.0, 0.0, 0.0]] * 2 + [_axis_vec(a) for a in ROTATE_AXES]
+                         + [_axis_vec(d) for d in TRANSLATE_DIRECTIONS])
+MODE_SKILL_ID = torch.tensor([SKILLS.index(mode_skill(m)) for m in MODES])
+
+
+@dataclasses.dataclass
+class Relational:
+    """The six relational poses, batched [N, 3] / [N, 4]."""
+
+    x_oh: torch.Tensor
+    q_oh: torch.Tensor
+    x_or: torch.Tensor
+    q_or: torch.Tensor
+    x_hr: torch.Tensor
+    q_hr: torch.Tensor
+
+    def flat(self) -> torch.Tensor:
+        return torch.cat([getattr(self, s) for s in SLOTS], dim=-1)
+
+    @staticmethod
+    def unflat(v: torch.Tensor) -> "Relational":
+        out, i = {}, 0
+        for s in SLOTS:
+            out[s] = v[..., i:i + SLOT_DIMS[s]]
+            i += SLOT_DIMS[s]
+        return Relational(**out)
+
+    def clone(self) -> "Relational":
+        return Relational(**{s: getattr(self, s).clone() for s in SLOTS})
+
+    def assign(self, other: "Relational", idx) -> None:
+        """self[idx] = other (in place, for partial resets)."""
+        for s in SLOTS:
+            getattr(self, s)[idx] = getattr(other, s)
+
+    def where(self, mask: torch.Tensor, other: "Relational") -> "Relational":
+        m = mask[:, None]
+        return Relational(**{s: torch.where(m, getattr(self, s), getattr(other, s)) for s in SLOTS})
+
+
+def relational_poses(root_p, root_q, hand_p, hand_q, obj_p, obj_q) -> Relational:
+    """World poses -> the six relational poses (quaternions with w >= 0)."""
+    x_oh, q_oh = relative_pose(hand_p, hand_q, obj_p, obj_q)
+    x_or, q_or = relative_pose(root_p, root_q, obj_p, obj_q)
+    x_hr, q_hr = relative_pose(root_p, root_q, hand_p, hand_q)
+    return Relational(x_oh, q_oh, x_or, q_or, x_hr, q_hr)
+
+
+@dataclasses.dataclass
+class MotionParams:
+    dt: float               # control period (s)
+    v_max: float            # translate speed (m/s)
+    omega_max: float        # rotate speed (rad/s)
+    relocate_v: float       # relocate interpolation speed (m/s)
+    relocate_omega: float   # relocate interpolation angular speed (rad/s)
+
+
+def _rule_index(slot: str) -> Tuple[List[str], torch.Tensor]:
+    rules = sorted({SKILL_TARGETS[s][slot] for s in SKILLS})
+    per_skill = torch.tensor([rules.index(SKILL_TARGETS[s][slot]) for s in SKILLS])
+    return rules, per_skill
+
+
+_SLOT_RULES = {slot: _rule_index(slot) for slot in SLOTS}
+
+
+def task_axis(mode: torch.Tensor, cur: Relational, final_x_or: torch.Tensor) -> torch.Tensor:
+    """d^h, unit vector in the hand frame: grasp object centre -> hand origin; relocate current
+    object position -> final position; rotate/translate the mode's fixed axis."""
+    skill = MODE_SKILL_ID.to(mode.device)[mode]
+    fixed = MODE_AXES.to(mode.device)[mode]
+    grasp_d = -cur.x_oh
+    reloc_d = quat_apply(quat_inv(cur.q_hr), final_x_or - cur.x_or)
+    d = torch.where((skill == 0)[:, None], grasp_d, torch.where((skill == 1)[:, None], reloc_d, fixed))
+    n = torch.linalg.norm(d, dim=-1, keepdim=True)
+    return torch.where(n > 1e-6, d / n.clamp_min(1e-6), torch.zeros_like(d))
+
+
+class _Rules:
+    """The tracked rules of the target table; each is a function of the step's context."""
+
+    @staticmethod
+    def palm(c):
+        return torch.zeros_like(c.cur.x_oh)
+
+    @staticmethod
+    def translate_along_axis(c):
+        return c.cur.x_oh + c.p.v_max * c.p.dt * c.axis
+
+    @staticmethod
+    def rotate_about_axis(c):
+        rot = quat_from_axis_angle(c.axis, torch.full_like(c.axis[:, 0], c.p.omega_max * c.p.dt))
+        return quat_positive(quat_mul(rot, c.cur.q_oh))
+
+    @staticmethod
+    def interpolate(c, slot):
+        if slot == "x_or":
+            step = c.final_x_or - c.cur.x_or
+            n = torch.linalg.norm(step, dim=-1, keepdim=True)
+            return c.cur.x_or + step * torch.clamp(c.p.relocate_v * c.p.dt / n.clamp_min(1e-9), max=1.0)
+        return slerp_toward(c.cur.q_or, c.final_q_or, c.p.relocate_omega * c.p.dt)
+
+    @staticmethod
+    def object_from_hand(c, slot):
+        """Root-frame object target from the current wrist and the hand-frame object target."""
+        if slot == "x_or":
+            return c.cur.x_hr + quat_apply(c.cur.q_hr, c.out["x_oh"])
+        return quat_positive(quat_mul(c.cur.q_hr, c.out["q_oh"]))
+
+    @staticmethod
+    def hand_from_object(c, slot):
+        """Hand target that realises the object target with the current object-in-hand pose."""
+        if "hand" not in c.cache:
+            inv_p, inv_q = pose_inv(c.cur.x_oh, c.cur.q_oh)
+            c.cache["hand"] = pose_mul(c.out["x_or"], c.out["q_or"], inv_p, inv_q)
+        hx, hq = c.cache["hand"]
+        return hx if slot == "x_hr" else quat_positive(hq)
+
+
+@dataclasses.dataclass
+class _Ctx:
+    cur: Relational
+    init: Relational
+    final_x_or: torch.Tensor
+    final_q_or: torch.Tensor
+    axis: torch.Tensor
+    p: MotionParams
+    out: dict
+    cache: dict
+
+
+def _candidate(rule: str, slot: str, c: _Ctx) -> torch.Tensor:
+    if rule == "fixed":
+        return getattr(c.init, slot)
+    if rule == "free":
+        return getattr(c.cur, slot)
+    fn = getattr(_Rules, rule)
+    return fn(c, slot) if rule in ("interpolate", "object_from_hand", "hand_from_object") else fn(c)
+
+
+def update_targets(mode: torch.Tensor, cur: Relational, init: Relational, final_x_or: torch.Tensor,
+                   final_q_or: torch.Tensor, axis: torch.Tensor, p: MotionParams,
+                   skill: str | None = None) -> Relational:
+    """Targets for the next step from the current relational state (paper §3.2).
+
+    Slots are filled in dependency order (hand-frame object targets, root-frame object targets,
+    hand targets). With ``skill`` given (all envs share it) only that skill's rules run;
+    otherwise every rule of a slot runs and each env selects its skill's rule.
+    """
+    c = _Ctx(cur, init, final_x_or, final_q_or, axis, p, {}, {})
+    env_skill = None if skill is not None else MODE_SKILL_ID.to(mode.device)[mode]
+    for slot in SLOTS:
+        if skill is not None:
+            c.out[slot] = _candidate(SKILL_TARGETS[skill][slot], slot, c)
+            continue
+        rules, per_skill = _SLOT_RULES[slot]
+        rid = per_skill.to(mode.device)[env_skill]
+        out = _candidate(rules[0], slot, c)
+        for i, r in enumerate(rules[1:], start=1):
+            out = torch.where((rid == i)[:, None], _candidate(r, slot, c), out)
+        c.out[slot] = out
+    return Relational(**c.out)
+
+
+FREE_BY_MODE = torch.tensor([[SKILL_TARGETS[mode_skill(m)][s] == "free" for s in SLOTS] for m in MODES])
+
+
+def with_free_as_current(mode: torch.Tensor, tgt: Relational, cur: Relational) -> Relational:
+    """Targets where Free slots take the current value (their tracking error is zero)."""
+    free = FREE_BY_MODE.to(mode.device)[mode]
+    return Relational(**{s: torch.where(free[:, i:i + 1], getattr(cur, s), getattr(tgt, s))
+                         for i, s in enumerate(SLOTS)})
+
+
+def goal_features(mode: torch.Tensor, axis: torch.Tensor, cur: Relational, tgt: Relational,
+                  zero_target: bool = False) -> torch.Tensor:
+    """g = [one-hot mode, d^h, g_current, g_target] (55-D)."""
+    onehot = torch.nn.functional.one_hot(mode, NUM_MODES).to(axis.dtype)
+    target = tgt.flat()
+    if zero_target:
+        target = torch.zeros_like(target)
+    return torch.cat([onehot, axis, cur.flat(), target], dim=-1)
+
+
+def wrist_reference(tgt: Relational) -> torch.Tensor:
+    """Virtual-joint values that realise the target hand pose: (x̂_h^r, Euler XYZ of q̂_h^r)."""
+    return torch.cat([tgt.x_hr, quat_to_euler_xyz(tgt.q_hr)], dim=-1)
+
+
+def map_action(action: torch.Tensor, prev_command: torch.Tensor, wrist_ref: torch.Tensor,
+               scale: torch.Tensor, lower: torch.Tensor, upper: torch.Tensor,
+               wrist_from_target: bool = True) -> torch.Tensor:
+    """q_act = clamp(q_ref + alpha * a, q_min, q_max); the first 6 joints are the virtual wrist."""
+    ref = prev_command.clone()
+    if wrist_from_target:
+        ref[:, :6] = wrist_ref
+    return torch.clamp(ref + scale * action, lower, upper)
+
+
+def finite_velocity(x_prev, q_prev, x_cur, q_cur, dt: float) -> Tuple[torch.Tensor, torch.Tensor]:
+    """Linear and angular velocity of a pose between two control steps, both expressed in the
+    pose's parent frame (e.g. the object's hand-frame velocity from x_oh, q_oh)."""
+    v = (x_cur - x_prev) / dt
+    w = quat_to_axis_angle(quat_mul(q_cur, quat_inv(q_prev))) / dt
+    return v, w

@@ -1,0 +1,80 @@
+"""Batched reads of link poses and hand-object contact forces, for CPU and GPU PhysX.
+
+Both backends return the same tensors on the env device:
+  * ``poses()``           -> positions [N, B, 3] and quaternions [N, B, 4] of the tracked bodies
+                             (hand frame, contact links, object), one gather per step;
+  * ``contact_forces()``  -> net contact force vector between each contact link and the object,
+                             [N, L, 3], in Newtons;
+  * ``apply_object_force(f)`` applies an external force to the object for the next sim step.
+On the GPU we use one pair-impulse query for all (link, object) pairs of all envs; on the CPU
+(one env per process) we read all contacts in one pass and accumulate per link, which costs a
+fraction of per-pair queries.
+"""
+from __future__ import annotations
+
+from typing import List
+
+import numpy as np
+import torch
+
+
+class HandObjectSensor:
+    def __init__(self, scene, hand_frame, links: List, obj):
+        """hand_frame and links are ManiSkill ``Link`` structs, obj an ``Actor`` struct."""
+        self.scene = scene
+        self.device = scene.device
+        self.gpu = scene.gpu_sim_enabled
+        self.num_links = len(links)
+        bodies = [hand_frame] + list(links) + [obj]
+        if self.gpu:
+            self._index = torch.cat([b._body_data_index for b in bodies]).to(self.device)
+            self._obj_index = obj._body_data_index.to(self.device)
+            pairs = [(link._bodies[e], obj._bodies[e]) for link in links for e in range(scene.num_envs)]
+            self._query = scene.px.gpu_create_contact_pair_impulse_query(pairs)
+        else:
+            self._components = [b._bodies[0] for b in bodies]
+            self._link_of_entity = {l._bodies[0].entity.per_scene_id: i for i, l in enumerate(links)}
+            self._obj_entity = obj._bodies[0].entity.per_scene_id
+            self._obj_body = obj._bodies[0]
+            self._zero3 = np.zeros(3, dtype=np.float32)
+        self._num_bodies = len(bodies)
+
+    def poses(self):
+        if self.gpu:
+            data = self.scene.px.cuda_rigid_body_data.torch()[self._index, :7]  # [B*N, 7], body-major
+            data = data.view(self._num_bodies, self.scene.num_envs, 7).transpose(0, 1)
+            return data[..., :3], data[..., 3:]
+        poses = [c.entity_pose for c in self._components]
+        p = torch.from_numpy(np.array([x.p for x in poses], dtype=np.float32))[None]
+        q = torch.from_numpy(np.array([x.q for x in poses], dtype=np.float32))[None]
+        return p, q
+
+    def contact_forces(self) -> torch.Tensor:
+        dt = self.scene.px.timestep
+        if self.gpu:
+            self.scene.px.gpu_query_contact_pair_impulses(self._query)
+            imp = self._query.cuda_impulses.torch().view(self.num_links, self.scene.num_envs, 3)
+            return imp.transpose(0, 1) / dt
+        out = np.zeros((self.num_links, 3), dtype=np.float32)
+        obj = self._obj_entity
+        lookup = self._link_of_entity
+        for c in self.scene.px.get_contacts():
+            e0, e1 = c.bodies[0].entity.per_scene_id, c.bodies[1].entity.per_scene_id
+            if e0 == obj and e1 in lookup:
+                sign, link = -1.0, lookup[e1]
+            elif e1 == obj and e0 in lookup:
+                sign, link = 1.0, lookup[e0]
+            else:
+                continue
+            for p in c.points:
+                out[link] += sign * p.impulse
+        return torch.from_numpy(out / dt)[None]
+
+    def apply_object_force(self, force) -> None:
+        """External force [N, 3] (world, Newtons) on the object's centre of mass for the next sim
+        step: a tensor on the env device (GPU) or, on the CPU, a tensor or a numpy array."""
+        if self.gpu:
+            self.scene.px.cuda_rigid_body_force.torch()[self._obj_index, :3] = force
+            self.scene.px.gpu_apply_rigid_dynamic_force()
+        else:
+            self._obj_body.add_force_torque(np.asarray(force[0], dtype=np.float32), self._zero3)
