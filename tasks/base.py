@@ -105,8 +105,11 @@ class UniCrossEnv(BaseEnv):
         self.static_skill = skills.pop() if len(skills) == 1 else None  # lets target updates skip other rules
         self.grasps: Optional[GraspSet] = None
         if any(F.mode_skill(m) != "grasp" for m in modes):
-            path = grasp_dataset or default_grasp_path(self.hand_spec.name)
-            self.grasps = GraspSet.load(path)
+            if isinstance(grasp_dataset, GraspSet):
+                path, self.grasps = "<in memory>", grasp_dataset
+            else:
+                path = grasp_dataset or default_grasp_path(self.hand_spec.name)
+                self.grasps = GraspSet.load(path)
             if self.grasps.hand != self.hand_spec.name:
                 raise ValueError(f"grasp dataset {path} is for hand {self.grasps.hand!r}, not {self.hand_spec.name!r}")
             needed = {objs[oi].name for oi, mi in self._pairs if F.mode_skill(F.MODES[mi]) != "grasp"}
@@ -367,6 +370,7 @@ class UniCrossEnv(BaseEnv):
         ref[:, :3] = ref[:, :3] + self.lift
         self.command = F.map_action(a, self.command, ref, self.action_scale, self.q_lower, self.q_upper,
                                     wrist_from_target=not self.cfg["ablation"]["no_target_action"])
+        self._pending = torch.ones_like(self._pending)  # evaluate() advances targets once per step
         obs, reward, _, _, info = super().step(self.command)
         terminated = info["fail"].clone()
         truncated = self.elapsed_steps >= self.episode_length[self.mode]
