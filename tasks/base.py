@@ -243,6 +243,8 @@ class UniCrossEnv(BaseEnv):
         self.hand_vel = z3.clone()
         self.hand_angvel = z3.clone()
         self._pending = torch.zeros(n, dtype=torch.bool, device=dev)
+        self._stepped = False
+        self.link_force = torch.zeros(n, len(self.contact_links), device=dev)
         self._gen = torch.Generator(device=dev)
         self._gen.manual_seed(int(self._episode_seed[0]))
 
@@ -339,6 +341,7 @@ class UniCrossEnv(BaseEnv):
         self.obj_z0[env_idx] = obj_p[:, 2]
         self.lift[env_idx] = 0
         self.perturb[env_idx] = 0
+        self.link_force[env_idx] = 0
         for t in (self.obj_vel_h, self.obj_angvel_h, self.hand_vel, self.hand_angvel):
             t[env_idx] = 0
         self._pending[env_idx] = True
@@ -371,6 +374,7 @@ class UniCrossEnv(BaseEnv):
         self.command = F.map_action(a, self.command, ref, self.action_scale, self.q_lower, self.q_upper,
                                     wrist_from_target=not self.cfg["ablation"]["no_target_action"])
         self._pending = torch.ones_like(self._pending)  # evaluate() advances targets once per step
+        self._stepped = True
         obs, reward, _, _, info = super().step(self.command)
         terminated = info["fail"].clone()
         truncated = self.elapsed_steps >= self.episode_length[self.mode]
@@ -407,7 +411,10 @@ class UniCrossEnv(BaseEnv):
         closest_o = closest_point_shapes(probe_o, self.obj_shape, self.obj_params, self.obj_tris)
         vec_w = quat_apply(obj_q[:, None].expand(-1, L, 4), closest_o - probe_o)  # link -> surface, world axes
         vec_h = quat_apply(quat_inv(hand_q)[:, None].expand(-1, L, 4), vec_w)      # ... in the hand frame
-        force = torch.linalg.norm(self.sensor.contact_forces(), dim=-1)
+        if self._stepped:  # contact forces exist only after a physics step; otherwise keep the last ones
+            self.link_force = torch.linalg.norm(self.sensor.contact_forces(), dim=-1)
+            self._stepped = False
+        force = self.link_force
         robot = self.agent.robot
         q = robot.get_qpos()[:, self._qidx]
         qd = robot.get_qvel()[:, self._qidx]
@@ -516,7 +523,7 @@ class UniCrossEnv(BaseEnv):
     # ------------------------------------------------------------------ state (sim + task)
     _TASK_STATE = ("root_p", "root_q", "init_rel", "targets", "prev_rel", "final_x_or", "final_q_or", "axis",
                    "command", "finger_q0", "rot_acc", "trans_acc", "ever_dropped", "obj_z0", "lift", "perturb",
-                   "obs_noise", "obj_vel_h", "obj_angvel_h", "hand_vel", "hand_angvel", "mode")
+                   "obs_noise", "obj_vel_h", "obj_angvel_h", "hand_vel", "hand_angvel", "link_force", "mode")
 
     def _task_state(self) -> Dict[str, torch.Tensor]:
         out = {}

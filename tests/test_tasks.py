@@ -1,0 +1,301 @@
+"""The ManiSkill tasks: spaces, determinism, state round trips, targets, contacts, drops, ablations."""
+import math
+
+import numpy as np
+import pytest
+import torch
+
+from conftest import make
+from unicross import formulation as F
+from unicross.geometry import quat_angle, quat_apply, quat_inv, quat_mul, quat_to_axis_angle
+
+TASKS = [("UniCross-Grasp-v1", {}), ("UniCross-Relocate-v1", {}), ("UniCross-Rotate-v1", {"axis": "x-"}),
+         ("UniCross-Translate-v1", {"direction": "z-"}), ("UniCross-MultiSkill-v1", {})]
+OBS = 2 * 22 + 5 * 21 + 55  # s^h + s^o + g for the floating Allegro
+
+
+@pytest.mark.parametrize("task,kw", TASKS)
+def test_reset_and_random_steps(task, kw, grasp_file):
+    env = make(task, grasp_file, **kw)
+    obs, info = env.reset(seed=1)
+    assert obs.shape == (1, OBS)
+    assert env.action_space.shape == (1, 22) and env.unwrapped.single_action_space.shape == (22,)
+    g = torch.Generator().manual_seed(0)
+    for _ in range(5):
+        obs, r, term, trunc, info = env.step(torch.rand(22, generator=g) * 2 - 1)
+        assert torch.isfinite(obs).all() and torch.isfinite(r).all()
+    u = env.unwrapped
+    sd = u.get_obs(unflattened=True)
+    assert sd["extra"]["goal"].shape == (1, 55)
+    assert sd["extra"]["hand"].shape == (1, 44)
+    assert {k: v.shape[-1] for k, v in sd["extra"]["object"].items()} == {"contact": 21, "force": 21, "distance": 63}
+    for k in ("success", "drop", "fail", "rotation", "translation", "relocate_pos_err", "reward_track"):
+        assert k in info
+    env.close()
+
+
+def test_state_dict_obs_mode(grasp_file):
+    env = make("UniCross-Rotate-v1", grasp_file, obs_mode="state_dict")
+    obs, _ = env.reset(seed=0)
+    assert set(obs) == {"agent", "extra"} and set(obs["extra"]) == {"hand", "object", "goal"}
+    assert obs["extra"]["goal"].shape == (1, F.GOAL_DIM) == (1, 55)
+    env.close()
+
+
+def test_nan_action_raises():
+    env = make("UniCross-Grasp-v1")
+    env.reset(seed=0)
+    a = torch.zeros(22)
+    a[3] = float("nan")
+    with pytest.raises(ValueError):
+        env.step(a)
+    with pytest.raises(ValueError):
+        env.step(torch.zeros(21))
+    env.close()
+
+
+@pytest.mark.parametrize("task,kw", [TASKS[0], TASKS[2]])
+def test_same_seed_same_observations(task, kw, grasp_file):
+    def run():
+        env = make(task, grasp_file, **kw)
+        out = [env.reset(seed=7)[0]]
+        g = torch.Generator().manual_seed(3)
+        for _ in range(4):
+            out.append(env.step(torch.rand(22, generator=g) * 2 - 1)[0])
+        env.close()
+        return torch.stack(out)
+    a, b = run(), run()
+    assert torch.equal(a, b)
+    # different seeds give different starts (randomisation is live)
+    env = make(task, grasp_file, **kw)
+    assert not torch.equal(env.reset(seed=7)[0], env.reset(seed=8)[0])
+    env.close()
+
+
+@pytest.mark.parametrize("task,kw", [TASKS[0], TASKS[3]])
+def test_state_round_trip(task, kw, grasp_file):
+    env = make(task, grasp_file, **kw)
+    u = env.unwrapped
+    env.reset(seed=2)
+    g = torch.Generator().manual_seed(1)
+    for _ in range(3):
+        obs, *_ = env.step(torch.rand(22, generator=g) * 2 - 1)
+    state = u.get_state()
+    saved_obs = u.get_obs()
+    nxt, *_ = env.step(torch.zeros(22))
+    for _ in range(3):
+        env.step(torch.rand(22, generator=g) * 2 - 1)
+    u.set_state(state)
+    assert torch.allclose(u.get_obs(), saved_obs, atol=1e-5)
+    # the dict form too, and stepping on from the restored state reproduces the next obs
+    u.set_state_dict(u.get_state_dict())
+    assert torch.allclose(u.get_obs(), saved_obs, atol=1e-5)
+    env.close()
+
+
+def test_invalid_arguments_fail_fast_with_valid_values():
+    with pytest.raises(ValueError, match="x\\+"):
+        make("UniCross-Rotate-v1", axis="w+")
+    with pytest.raises(ValueError, match="z\\+"):
+        make("UniCross-Translate-v1", direction="x+")
+    with pytest.raises(ValueError, match="allegro"):
+        make("UniCross-Grasp-v1", hand="nohand")
+    with pytest.raises(ValueError, match="train-wrappable"):
+        make("UniCross-Grasp-v1", objects="no-such-set")
+    with pytest.raises(ValueError, match="grasp"):
+        make("UniCross-MultiSkill-v1", modes=["fly"])
+    with pytest.raises(FileNotFoundError, match="unicross grasps"):
+        make("UniCross-Relocate-v1", grasp_dataset="/nonexistent/grasps.pt")
+    with pytest.raises(ValueError, match="no object"):
+        make("UniCross-Rotate-v1", objects="train-elongated")  # rotate needs wrappable objects
+
+
+def test_multiskill_pairs_are_valid(tiny_objects, grasp_file):
+    env = make("UniCross-MultiSkill-v1", grasp_file)
+    u = env.unwrapped
+    assert len(u._pairs) == 2 * 8 + 2 * 4  # wrappable: grasp, relocate, 6 rotations; elongated: grasp, relocate, 2 translations
+    for oi, mi in u._pairs:
+        skill = F.mode_skill(F.MODES[mi])
+        cat = u.object_specs[oi].category
+        assert not (skill == "rotate" and cat != "wrappable") and not (skill == "translate" and cat != "elongated")
+    assert u.mode.shape == (1,) and u.mode.dtype == torch.long
+    env.close()
+
+
+# ----------------------------------------------------------------------------- target semantics
+def _step(env, n, seed=0):
+    g = torch.Generator().manual_seed(seed)
+    for _ in range(n):
+        env.step((torch.rand(22, generator=g) * 2 - 1) * 0.3)
+
+
+def test_rotate_targets(grasp_file):
+    env = make("UniCross-Rotate-v1", grasp_file, axis="y+")
+    u = env.unwrapped
+    env.reset(seed=0)
+    init = u.init_rel.clone()
+    w_dt = u.cfg["motion"]["omega_max"] * u.control_dt
+    for k in range(4):
+        _step(env, 1, seed=k)
+        t, c = u.targets, u.cur_rel
+        assert torch.allclose(t.x_hr, init.x_hr) and torch.allclose(t.q_hr, init.q_hr)   # wrist fixed
+        assert torch.allclose(t.x_oh, init.x_oh) and torch.allclose(t.x_or, init.x_or)   # position fixed
+        rv = quat_to_axis_angle(quat_mul(t.q_oh, quat_inv(c.q_oh)))                       # q̂_oh = R(ωΔt, d) q_oh
+        assert torch.allclose(rv, torch.tensor([[0.0, w_dt, 0.0]]), atol=1e-5)
+        assert torch.allclose(u.axis, torch.tensor([[0.0, 1.0, 0.0]]))
+        assert quat_angle(t.q_or, quat_mul(c.q_hr, t.q_oh)).item() < 1e-4               # q̂_or from the current wrist
+    env.close()
+
+
+def test_translate_targets(grasp_file):
+    env = make("UniCross-Translate-v1", grasp_file, direction="z+")
+    u = env.unwrapped
+    env.reset(seed=0)
+    init = u.init_rel.clone()
+    v_dt = u.cfg["motion"]["v_max"] * u.control_dt
+    for k in range(4):
+        _step(env, 1, seed=k)
+        t, c = u.targets, u.cur_rel
+        assert torch.allclose(t.x_oh - c.x_oh, torch.tensor([[0.0, 0.0, v_dt]]), atol=1e-6)
+        assert torch.allclose(t.q_oh, init.q_oh) and torch.allclose(t.q_or, init.q_or)
+        assert torch.allclose(t.x_hr, init.x_hr) and torch.allclose(t.q_hr, init.q_hr)
+        assert torch.allclose(t.x_or, c.x_hr + quat_apply(c.q_hr, t.x_oh), atol=1e-6)
+    env.close()
+
+
+def test_relocate_targets_interpolate_to_final(grasp_file):
+    env = make("UniCross-Relocate-v1", grasp_file)
+    u = env.unwrapped
+    env.reset(seed=0)
+    init = u.init_rel.clone()
+    v_dt = u.cfg["motion"]["relocate_v"] * u.control_dt
+    w_dt = u.cfg["motion"]["relocate_omega"] * u.control_dt
+    for k in range(4):
+        _step(env, 1, seed=k)
+        t, c = u.targets, u.cur_rel
+        step = t.x_or - c.x_or
+        to_final = u.final_x_or - c.x_or
+        assert torch.allclose(step.norm(), torch.minimum(torch.tensor(v_dt), to_final.norm()), atol=1e-5)
+        assert torch.nn.functional.cosine_similarity(step, to_final).item() > 0.9999
+        ang_step = quat_angle(c.q_or, t.q_or)
+        ang_total = quat_angle(c.q_or, u.final_q_or)
+        assert torch.allclose(ang_step, torch.minimum(torch.tensor(w_dt), ang_total), atol=1e-4)
+        assert torch.allclose(t.x_oh, init.x_oh) and torch.allclose(t.q_oh, init.q_oh)     # fixed in hand
+        # the hand target realises the object target with the current object-in-hand pose
+        assert torch.allclose(t.x_hr + quat_apply(t.q_hr, c.x_oh), t.x_or, atol=1e-5)
+    env.close()
+
+
+def test_grasp_targets():
+    env = make("UniCross-Grasp-v1")
+    u = env.unwrapped
+    env.reset(seed=0)
+    init = u.init_rel.clone()
+    for k in range(4):
+        _step(env, 1, seed=k)
+        t, c = u.targets, u.cur_rel
+        assert torch.allclose(t.x_or, init.x_or) and torch.allclose(t.q_or, init.q_or)     # object fixed in root
+        assert torch.equal(t.x_hr, c.x_hr) and torch.equal(t.q_hr, c.q_hr)                  # hand free
+        assert torch.equal(t.q_oh, c.q_oh)
+        assert torch.equal(t.x_oh, torch.zeros_like(t.x_oh))                                # towards the palm point
+        d = -c.x_oh / c.x_oh.norm()
+        assert torch.allclose(u.axis, d, atol=1e-6)                                         # object centre -> hand origin
+    env.close()
+
+
+def test_action_mapping_residuals():
+    env = make("UniCross-Grasp-v1", randomize=False)
+    u = env.unwrapped
+    env.reset(seed=0)
+    a = torch.zeros(1, 22)
+    a[0, 0] = 1.0
+    a[0, 10] = -1.0
+    prev = u.command.clone()
+    wrist_ref = F.wrist_reference(u.targets)
+    env.step(a)
+    expected = prev.clone()
+    expected[:, :6] = wrist_ref
+    expected = torch.clamp(expected + u.action_scale * a, u.q_lower, u.q_upper)
+    assert torch.allclose(u.command, expected, atol=1e-6)
+    assert torch.allclose(u.command[0, 0], wrist_ref[0, 0] + u.hand_spec.action_scale["wrist_translation"])
+    # fingers: residual on the previous command, clamped at the joint limit
+    for _ in range(40):
+        env.step(a)
+    assert torch.allclose(u.command[0, 10], u.q_lower[10])
+    env.close()
+
+
+# ----------------------------------------------------------------------------- contacts and drops
+def test_contact_flags_follow_pressing():
+    from unicross.scripted_grasp import ScriptedGrasp
+    env = make("UniCross-Grasp-v1", randomize=False, config=dict(grasp=dict(lift_after=None)))
+    u = env.unwrapped
+    env.reset(seed=0)
+    sd = u.get_obs(unflattened=True)["extra"]["object"]
+    assert sd["contact"].sum() == 0 and sd["force"].sum() == 0  # hovering: nothing touches
+    policy = ScriptedGrasp(u)
+    for _ in range(policy.t_lift):
+        env.step(policy())
+    sd = u.get_obs(unflattened=True)["extra"]["object"]
+    c, f = sd["contact"][0], sd["force"][0]
+    dist = sd["distance"][0].view(-1, 3).norm(dim=-1)
+    assert c.sum() >= 2                                  # fingers press the object
+    assert torch.all((c > 0) == (f > u.cfg["contact_force_threshold"]))
+    assert torch.all(f[c == 0] <= u.cfg["contact_force_threshold"])
+    assert torch.all(dist[c > 0] < 0.03)                 # pressing links are at the surface
+    # move the object away from the hand: after the next physics step no link is in contact
+    obj = u.obj.pose
+    u.obj.set_pose(obj.__class__.create_from_pq(obj.p + torch.tensor([0.4, 0.0, 0.0]), obj.q))
+    env.step(torch.zeros(22))
+    sd = u.get_obs(unflattened=True)["extra"]["object"]
+    assert sd["contact"].sum() == 0
+    env.close()
+
+
+def test_drop_terminates(grasp_file):
+    env = make("UniCross-Rotate-v1", grasp_file)
+    u = env.unwrapped
+    env.reset(seed=0)
+    _, _, term, _, info = env.step(torch.zeros(22))
+    assert not term.any()
+    pose = u.obj.pose
+    u.obj.set_pose(pose.__class__.create_from_pq(pose.p + torch.tensor([0.0, 0.0, -0.4]), pose.q))
+    _, r, term, _, info = env.step(torch.zeros(22))
+    assert term.all() and info["drop"].all() and info["fail"].all() and not info["success"].any()
+    assert info["reward_drop"].item() == pytest.approx(u.reward_cfg["reg"]["w_drop"])
+
+
+# ----------------------------------------------------------------------------- ablation switches
+def test_ablation_switches(grasp_file):
+    abl = dict(no_target_obs=True, no_distance=True, no_contact=True, no_track_reward=True, no_target_action=True)
+    env = make("UniCross-Relocate-v1", grasp_file, config=dict(ablation=abl))
+    u = env.unwrapped
+    env.reset(seed=0)
+    prev = u.command.clone()
+    obs, r, *_ , info = env.step(torch.zeros(22))
+    sd = u.get_obs(unflattened=True)["extra"]
+    assert torch.all(sd["goal"][:, -21:] == 0)
+    assert torch.all(sd["object"]["distance"] == 0) and torch.all(sd["object"]["contact"] == 0)
+    assert torch.all(sd["object"]["force"] == 0)
+    assert info["reward_track"].item() == 0.0
+    assert torch.allclose(u.command[:, :6], prev[:, :6])   # wrist reference = previous command
+    env.close()
+    base = make("UniCross-Relocate-v1", grasp_file)
+    base.reset(seed=0)
+    *_, info = base.step(torch.zeros(22))
+    assert info["reward_track"].item() != 0.0
+    assert base.unwrapped.get_obs(unflattened=True)["extra"]["goal"][:, -21:].abs().sum() > 0
+    base.close()
+
+
+def test_reward_terms_use_config_coefficients(grasp_file):
+    env = make("UniCross-Grasp-v1", reward_config=dict(contact=dict(grasp=dict(w_dis=0.0, w_con=0.0, w_f=0.0))))
+    env.reset(seed=0)
+    *_, info = env.step(torch.zeros(22))
+    assert info["reward_contact"].item() == 0.0
+    env.close()
+    env = make("UniCross-Grasp-v1")
+    env.reset(seed=0)
+    *_, info = env.step(torch.zeros(22))
+    assert info["reward_contact"].item() < 0  # hovering: -w_dis * distance dominates
+    env.close()
