@@ -76,7 +76,7 @@ class HandSpec:
 
     @property
     def uid(self) -> str:
-        return f"unicross_floating_{self.name}"
+        return f"unicross_floating_{self.name}" + ("_selfcollide" if self.self_collision else "")
 
     def init_finger_qpos(self, category: str) -> np.ndarray:
         """Initial finger pose (theta0 for 'wrappable', theta1 for 'elongated') in

@@ -22,6 +22,7 @@ import sapien
 import torch
 from gymnasium import spaces
 from gymnasium.vector.utils import batch_space
+from mani_skill import logger
 from mani_skill.envs.sapien_env import BaseEnv
 from mani_skill.utils import common
 from mani_skill.utils.structs.actor import Actor
@@ -72,12 +73,16 @@ class UniCrossEnv(BaseEnv):
     DEFAULT_OBJECTS = "train"
     DEFAULT_MODES: Sequence[str] = F.MODES
 
-    def __init__(self, *args, hand: str = "allegro", objects=None, object_limit: Optional[int] = None,
+    def __init__(self, *args, hand: str = "allegro", hand_overrides: Optional[dict] = None,
+                 objects=None, object_limit: Optional[int] = None,
                  modes: Optional[Sequence[str]] = None, grasp_dataset: Optional[str] = None,
                  config: Optional[dict] = None, reward_config: Optional[dict] = None,
                  randomize: Optional[bool] = None, robot_uids=None, **kwargs):
         # ---- validate everything before any simulation starts
         self.hand_spec: HandSpec = load_hand(hand)
+        if hand_overrides:
+            import dataclasses
+            self.hand_spec = dataclasses.replace(self.hand_spec, **hand_overrides)
         self.cfg = load_config("task", config)
         if randomize is not None:
             self.cfg["randomization"]["enabled"] = bool(randomize)
@@ -112,11 +117,17 @@ class UniCrossEnv(BaseEnv):
                 self.grasps = GraspSet.load(path)
             if self.grasps.hand != self.hand_spec.name:
                 raise ValueError(f"grasp dataset {path} is for hand {self.grasps.hand!r}, not {self.hand_spec.name!r}")
+            have = {n for n, c in self.grasps.counts().items() if c > 0}
             needed = {objs[oi].name for oi, mi in self._pairs if F.mode_skill(F.MODES[mi]) != "grasp"}
-            missing = sorted(needed - set(self.grasps.object_names))
-            if missing:
-                raise ValueError(f"grasp dataset {path} has no grasps for {len(missing)} object(s), e.g. "
-                                 f"{missing[:3]}; build them with `unicross grasps --objects <set>`")
+            missing = sorted(needed - have)
+            if missing and len(missing) == len(needed):
+                raise ValueError(f"grasp dataset {path} has no grasps for the {len(missing)} object(s) of "
+                                 f"this set, e.g. {missing[:3]}; build them with `unicross grasps --objects <set>`")
+            if missing:  # a few objects the synthesiser could not grasp: they only serve the grasp mode
+                logger.warning(f"{len(missing)} object(s) have no grasp in {path} and are left out of the "
+                               f"in-hand modes, e.g. {missing[:3]}")
+                self._pairs = [(oi, mi) for oi, mi in self._pairs
+                               if F.mode_skill(F.MODES[mi]) == "grasp" or objs[oi].name in have]
         register_hand_agent(self.hand_spec)
         super().__init__(*args, robot_uids=self.hand_spec.uid, **kwargs)
         n = self.hand_spec.dof
@@ -178,6 +189,7 @@ class UniCrossEnv(BaseEnv):
         specs = [self.object_specs[p[0]] for p in pairs]
         self.env_objects = specs
         self.obj_shape = torch.tensor([s.shape_type for s in specs], device=dev)
+        self.shape_kinds = frozenset(s.shape_type for s in specs)
         self.obj_params = torch.tensor(np.stack([s.params for s in specs]), device=dev)
         self.obj_category = torch.tensor([CATEGORY_ID[s.category] for s in specs], device=dev)
         self.obj_rest_height = torch.tensor([[s.half_height_on_table(False), s.half_height_on_table(True)]
@@ -217,6 +229,7 @@ class UniCrossEnv(BaseEnv):
         self.motion = F.MotionParams(dt=self.control_dt, **self.cfg["motion"])
         self._speed_cap = torch.tensor([self.cfg["motion"]["omega_max"] if F.mode_skill(m) == "rotate"
                                         else self.cfg["motion"]["v_max"] for m in F.MODES], device=dev)
+        self._world_up = torch.tensor([0.0, 0.0, 1.0], device=dev)
         self._alloc_buffers()
 
     def _alloc_buffers(self):
@@ -382,10 +395,10 @@ class UniCrossEnv(BaseEnv):
 
     def _advance_lift(self):
         lift_after = self.cfg["grasp"]["lift_after"]
-        if lift_after is None:
+        if lift_after is None or self.static_skill not in (None, "grasp"):
             return
         lifting = (self.mode == 0) & (self.elapsed_steps >= lift_after)
-        up_root = quat_apply(quat_inv(self.root_q), torch.tensor([0.0, 0.0, 1.0], device=self.device).expand_as(self.lift))
+        up_root = quat_apply(quat_inv(self.root_q), self._world_up.expand_as(self.lift))
         self.lift = self.lift + lifting[:, None].float() * up_root * self.cfg["grasp"]["lift_speed"] * self.control_dt
 
     def _before_simulation_step(self):
@@ -408,7 +421,7 @@ class UniCrossEnv(BaseEnv):
         probe_w = link_p + quat_apply(link_q, self.link_probe.expand(self.num_envs, L, 3))
         inv_q = quat_inv(obj_q)[:, None].expand(-1, L, 4)
         probe_o = quat_apply(inv_q, probe_w - obj_p[:, None])
-        closest_o = closest_point_shapes(probe_o, self.obj_shape, self.obj_params, self.obj_tris)
+        closest_o = closest_point_shapes(probe_o, self.obj_shape, self.obj_params, self.obj_tris, self.shape_kinds)
         vec_w = quat_apply(obj_q[:, None].expand(-1, L, 4), closest_o - probe_o)  # link -> surface, world axes
         vec_h = quat_apply(quat_inv(hand_q)[:, None].expand(-1, L, 4), vec_w)      # ... in the hand frame
         if self._stepped:  # contact forces exist only after a physics step; otherwise keep the last ones

@@ -247,22 +247,38 @@ def closest_point_triangles(p: torch.Tensor, tris: torch.Tensor) -> torch.Tensor
 
 
 def closest_point_shapes(p: torch.Tensor, shape_type: torch.Tensor, params: torch.Tensor,
-                         tris: torch.Tensor | None = None) -> torch.Tensor:
+                         tris: torch.Tensor | None = None, kinds: frozenset | None = None) -> torch.Tensor:
     """Closest surface point for points ``p`` [B, L, 3] given in each object's frame.
 
     shape_type [B] (SHAPE_*), params [B, 4]:
       box (hx, hy, hz, -), cylinder (radius, half_len, -, -) along x, sphere (radius, -, -, -),
       prism (circumradius, half_len, n_sides, -) along x, mesh (uses ``tris`` [B, F, 3, 3]).
-    Every formula runs for the whole batch and the right one is selected per object, so a batch
-    may mix shapes (heterogeneous objects across parallel envs).
+    The formula of every shape kind present runs for the whole batch and each object selects its
+    own, so a batch may mix shapes (heterogeneous objects across parallel envs). ``kinds`` (the
+    set of SHAPE_* present, known when the scene is built) skips absent kinds.
     """
+    kinds = kinds if kinds is not None else frozenset({SHAPE_BOX, SHAPE_CYLINDER, SHAPE_SPHERE, SHAPE_PRISM}
+                                                      | ({SHAPE_MESH} if tris is not None else set()))
     st = shape_type[:, None, None]
     pr = params[:, None, :].expand(-1, p.shape[1], -1)
-    out = closest_point_box(p, pr[..., :3])
-    n_sides = torch.where(st[..., 0] == SHAPE_CYLINDER, torch.zeros_like(pr[..., 2]), pr[..., 2])
-    prism = closest_point_prism(p, pr[..., 0], pr[..., 1], n_sides)
-    out = torch.where((st == SHAPE_CYLINDER) | (st == SHAPE_PRISM), prism, out)
-    out = torch.where(st == SHAPE_SPHERE, closest_point_sphere(p, pr[..., 0]), out)
-    if tris is not None:
-        out = torch.where(st == SHAPE_MESH, closest_point_triangles(p, tris), out)
+    out = None
+
+    def put(mask_kinds, value):
+        nonlocal out
+        if out is None or len(kinds) == 1:
+            out = value
+        else:
+            m = st == mask_kinds[0] if len(mask_kinds) == 1 else (st == mask_kinds[0]) | (st == mask_kinds[1])
+            out = torch.where(m, value, out)
+
+    if SHAPE_BOX in kinds:
+        put((SHAPE_BOX,), closest_point_box(p, pr[..., :3]))
+    if SHAPE_CYLINDER in kinds or SHAPE_PRISM in kinds:
+        n_sides = pr[..., 2] if SHAPE_CYLINDER not in kinds else \
+            torch.where(st[..., 0] == SHAPE_CYLINDER, torch.zeros_like(pr[..., 2]), pr[..., 2])
+        put((SHAPE_CYLINDER, SHAPE_PRISM), closest_point_prism(p, pr[..., 0], pr[..., 1], n_sides))
+    if SHAPE_SPHERE in kinds:
+        put((SHAPE_SPHERE,), closest_point_sphere(p, pr[..., 0]))
+    if SHAPE_MESH in kinds:
+        put((SHAPE_MESH,), closest_point_triangles(p, tris))
     return out

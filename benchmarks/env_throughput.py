@@ -1,0 +1,129 @@
+"""Control steps/s of every UniCross task id on the CPU, and the ratio to bare physics.
+
+For each id the env steps with zero actions from a reset (relocate/rotate/translate start from a
+grasp, so the hand holds the object; grasp runs the scripted grasp first so the hand holds it too)
+and we time (a) ``env.step`` and (b) bare physics of the same scene: the same number of PhysX
+substeps per control step with no task code. Both are measured in this one run, interleaved, and
+reported as steps/s and as a ratio.
+
+A second table compares the physics settings that decide speed (hand self-collision, contact
+offset) on a holding scene: bare physics control steps/s for each combination.
+
+    python benchmarks/env_throughput.py [--steps 300] [--json out.json]
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+import time
+
+import torch
+
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+import gymnasium as gym  # noqa: E402
+
+import unicross  # noqa: E402,F401
+from unicross.grasps import GraspSet, default_grasp_path  # noqa: E402
+from unicross.scripted_grasp import ScriptedGrasp, synthesize  # noqa: E402
+from unicross.objects import get_object_set  # noqa: E402
+
+TASKS = [("UniCross-Grasp-v1", {}), ("UniCross-Relocate-v1", {}), ("UniCross-Rotate-v1", {"axis": "z+"}),
+         ("UniCross-Translate-v1", {"direction": "z+"}), ("UniCross-MultiSkill-v1", {})]
+
+
+def _holding_env(task, kw, grasps, objects, **extra):
+    env = gym.make(task, obs_mode="state", sim_backend="physx_cpu", render_backend="none", objects=objects,
+                   grasp_dataset=grasps, randomize=False, config=dict(grasp=dict(lift_after=None)), **kw, **extra)
+    u = env.unwrapped
+    u.reset(seed=0)
+    if task == "UniCross-Grasp-v1":
+        policy = ScriptedGrasp(u)
+        for _ in range(policy.t_lift + 5):
+            u.step(policy())
+    return env, u
+
+
+def _time_env(u, steps, seed=0):
+    """env.step with small random actions; returns (steps/s, joint commands, mean links in contact)."""
+    g = torch.Generator().manual_seed(seed)
+    actions = (torch.rand(steps, 1, u.hand_spec.dof, generator=g) * 2 - 1) * 0.3
+    commands, contacts = [], 0
+    t = time.perf_counter()
+    for i in range(steps):
+        *_, info = u.step(actions[i])
+        commands.append(u.command)
+        contacts += info["num_contacts"]
+    rate = steps / (time.perf_counter() - t)
+    art = u.agent.robot._objs[0]
+    order = u._qidx.tolist()  # hand-spec order -> articulation joint order
+    joints = [art.active_joints[i] for i in order]
+    return rate, [c[0].tolist() for c in commands], joints, float(contacts.item()) / steps
+
+
+def _time_physics(u, commands, joints):
+    """Bare physics of the same scene: the same drive targets, PhysX substeps, no task code."""
+    k = u._sim_steps_per_control
+    t = time.perf_counter()
+    for cmd in commands:
+        for j, target in zip(joints, cmd):
+            j.set_drive_target(target)
+        for _ in range(k):
+            u.scene.step()
+    return len(commands) / (time.perf_counter() - t)
+
+
+def main():
+    p = argparse.ArgumentParser()
+    p.add_argument("--steps", type=int, default=300)
+    p.add_argument("--json", default=None)
+    args = p.parse_args()
+    torch.set_num_threads(1)
+    objects = get_object_set("train", limit=1)
+    gs, _ = synthesize("allegro", objects, per_object=1, seed=0, progress=False)
+    rows = []
+    for task, kw in TASKS:
+        env, u = _holding_env(task, kw, gs, objects)
+        state = u.get_state_dict()
+        env_rates, phys_rates = [], []
+        for _ in range(3):  # interleave to share machine noise
+            u.set_state_dict(state)
+            rate, commands, joints, contacts = _time_env(u, args.steps)
+            env_rates.append(rate)
+            u.set_state_dict(state)
+            phys_rates.append(_time_physics(u, commands, joints))
+        e, b = max(env_rates), max(phys_rates)
+        rows.append(dict(task=task, env_steps_per_s=round(e, 1), bare_physics_steps_per_s=round(b, 1),
+                         ratio=round(e / b, 3), contacts=round(contacts, 1)))
+        env.close()
+    print(f"{'task':28s} {'env steps/s':>12s} {'bare physics':>13s} {'ratio':>6s} {'links in contact':>17s}")
+    for r in rows:
+        print(f"{r['task']:28s} {r['env_steps_per_s']:12.0f} {r['bare_physics_steps_per_s']:13.0f} {r['ratio']:6.2f} {r['contacts']:17.1f}")
+    settings = []
+    for self_collision in (True, False):
+        for offset in (0.02, 0.002):
+            env, u = _holding_env("UniCross-Relocate-v1", {}, gs, objects,
+                                  hand_overrides=dict(self_collision=self_collision),
+                                  sim_config=dict(scene_config=dict(contact_offset=offset)))
+            state = u.get_state_dict()
+            _, commands, joints, _ = _time_env(u, args.steps)
+            rates = []
+            for _ in range(2):
+                u.set_state_dict(state)
+                rates.append(_time_physics(u, commands, joints))
+            settings.append(dict(self_collision=self_collision, contact_offset=offset,
+                                 bare_physics_steps_per_s=round(max(rates), 1)))
+            env.close()
+    base = settings[0]["bare_physics_steps_per_s"]
+    print("\nphysics settings (relocate scene, hand holding the object), bare physics control steps/s:")
+    for s in settings:
+        print(f"  self_collision={str(s['self_collision']):5s} contact_offset={s['contact_offset']:<6} "
+              f"{s['bare_physics_steps_per_s']:8.0f}  ({s['bare_physics_steps_per_s'] / base:.2f}x the package defaults)")
+    if args.json:
+        with open(args.json, "w") as f:
+            json.dump(dict(tasks=rows, physics_settings=settings), f, indent=1)
+
+
+if __name__ == "__main__":
+    main()
