@@ -230,6 +230,9 @@ class UniCrossEnv(BaseEnv):
         self._speed_cap = torch.tensor([self.cfg["motion"]["omega_max"] if F.mode_skill(m) == "rotate"
                                         else self.cfg["motion"]["v_max"] for m in F.MODES], device=dev)
         self._world_up = torch.tensor([0.0, 0.0, 1.0], device=dev)
+        if not self.gpu_sim_enabled:  # raw PhysX joints in hand-spec order (CPU: one env)
+            art = robot._objs[0]
+            self._cpu_joints = [art.active_joints[i] for i in self._qidx.tolist()]
         self._alloc_buffers()
 
     def _alloc_buffers(self):
@@ -237,7 +240,7 @@ class UniCrossEnv(BaseEnv):
         z3, z4 = torch.zeros(n, 3, device=dev), torch.zeros(n, 4, device=dev)
         ident = z4.clone()
         ident[:, 0] = 1
-        rel = lambda: F.Relational(z3.clone(), ident.clone(), z3.clone(), ident.clone(), z3.clone(), ident.clone())
+        rel = lambda: F.Relational(x_oh=z3, q_oh=ident, x_or=z3, q_or=ident, x_hr=z3, q_hr=ident)
         self.root_p, self.root_q = z3.clone(), ident.clone()
         self.init_rel, self.targets, self.prev_rel, self.cur_rel = rel(), rel(), rel(), rel()
         self.final_x_or, self.final_q_or = z3.clone(), ident.clone()
@@ -328,7 +331,7 @@ class UniCrossEnv(BaseEnv):
         xo, qo = relative_pose(hand_p, hand_q, obj_p, obj_q)
         ident = torch.zeros(b, 4, device=dev)
         ident[:, 0] = 1
-        init = F.Relational(xo, qo, xo.clone(), qo.clone(), torch.zeros_like(xo), ident)
+        init = F.Relational(x_oh=xo, q_oh=qo, x_or=xo, q_or=qo, x_hr=torch.zeros_like(xo), q_hr=ident)
         self.init_rel.assign(init, env_idx)
         self.targets.assign(init, env_idx)
         self.prev_rel.assign(init, env_idx)
@@ -366,9 +369,13 @@ class UniCrossEnv(BaseEnv):
         return obs, info
 
     def _apply_command(self):
-        self.agent.controller.set_drive_targets(self.command)
+        """PD targets of all joints = the current command (one write on GPU, raw joints on CPU)."""
         if self.gpu_sim_enabled:
+            self.agent.robot.set_joint_drive_targets(self.command, joint_indices=self._qidx)
             self.scene.px.gpu_apply_articulation_target_position()
+        else:
+            for joint, target in zip(self._cpu_joints, self.command[0].tolist()):
+                joint.set_drive_target(target)
 
     # ------------------------------------------------------------------ stepping
     def step(self, action):
@@ -388,7 +395,8 @@ class UniCrossEnv(BaseEnv):
                                     wrist_from_target=not self.cfg["ablation"]["no_target_action"])
         self._pending = torch.ones_like(self._pending)  # evaluate() advances targets once per step
         self._stepped = True
-        obs, reward, _, _, info = super().step(self.command)
+        self._apply_command()
+        obs, reward, _, _, info = super().step(None)  # drive targets are set; ManiSkill runs the substeps
         terminated = info["fail"].clone()
         truncated = self.elapsed_steps >= self.episode_length[self.mode]
         return obs, reward, terminated, truncated, info
@@ -442,9 +450,9 @@ class UniCrossEnv(BaseEnv):
         pend = self._pending
         # velocities and accumulated motion over the last control step
         dt = self.control_dt
-        prev = self.prev_rel
-        v, w = F.finite_velocity(prev.x_oh, prev.q_oh, cur.x_oh, cur.q_oh, dt)
-        hv, hw = F.finite_velocity(prev.x_hr, prev.q_hr, cur.x_hr, cur.q_hr, dt)
+        (xp, qp), (xc, qc) = self.prev_rel.poses(), cur.poses()
+        vel, angvel = F.finite_velocity(xp[:, ::2], qp[:, ::2], xc[:, ::2], qc[:, ::2], dt)  # object in hand, hand in root
+        v, w, hv, hw = vel[:, 0], angvel[:, 0], vel[:, 1], angvel[:, 1]
         p1 = pend[:, None]
         self.obj_vel_h = torch.where(p1, v, self.obj_vel_h)
         self.obj_angvel_h = torch.where(p1, w, self.obj_angvel_h)

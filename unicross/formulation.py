@@ -95,47 +95,75 @@ MODE_AXES = torch.tensor([[0.0, 0.0, 0.0]] * 2 + [_axis_vec(a) for a in ROTATE_A
 MODE_SKILL_ID = torch.tensor([SKILLS.index(mode_skill(m)) for m in MODES])
 
 
-@dataclasses.dataclass
-class Relational:
-    """The six relational poses, batched [N, 3] / [N, 4]."""
+_OFFSETS = {}
+_o = 0
+for _s in SLOTS:
+    _OFFSETS[_s] = (_o, _o + SLOT_DIMS[_s])
+    _o += SLOT_DIMS[_s]
 
-    x_oh: torch.Tensor
-    q_oh: torch.Tensor
-    x_or: torch.Tensor
-    q_or: torch.Tensor
-    x_hr: torch.Tensor
-    q_hr: torch.Tensor
+
+class Relational:
+    """The six relational poses, stored as one [N, 21] tensor (slot order ``SLOTS``: for each of
+    object-in-hand, object-in-root, hand-in-root a position then a quaternion). Slots are views,
+    so whole-state operations (select, copy, observe) are single tensor ops."""
+
+    __slots__ = ("data",)
+
+    def __init__(self, data: torch.Tensor | None = None, **slots):
+        if data is None:
+            data = torch.cat([slots[s] for s in SLOTS], dim=-1)
+        self.data = data
+
+    @staticmethod
+    def from_poses(x: torch.Tensor, q: torch.Tensor) -> "Relational":
+        """From stacked poses x [N, 3, 3], q [N, 3, 4] in the order (o in h, o in r, h in r)."""
+        return Relational(torch.cat([x, q], dim=-1).reshape(x.shape[0], 21))
+
+    def poses(self):
+        """Stacked positions [N, 3, 3] and quaternions [N, 3, 4] (o in h, o in r, h in r)."""
+        v = self.data.view(-1, 3, 7)
+        return v[..., :3], v[..., 3:]
 
     def flat(self) -> torch.Tensor:
-        return torch.cat([getattr(self, s) for s in SLOTS], dim=-1)
+        return self.data
 
     @staticmethod
     def unflat(v: torch.Tensor) -> "Relational":
-        out, i = {}, 0
-        for s in SLOTS:
-            out[s] = v[..., i:i + SLOT_DIMS[s]]
-            i += SLOT_DIMS[s]
-        return Relational(**out)
+        return Relational(v)
 
     def clone(self) -> "Relational":
-        return Relational(**{s: getattr(self, s).clone() for s in SLOTS})
+        return Relational(self.data.clone())
 
     def assign(self, other: "Relational", idx) -> None:
         """self[idx] = other (in place, for partial resets)."""
-        for s in SLOTS:
-            getattr(self, s)[idx] = getattr(other, s)
+        self.data[idx] = other.data
 
     def where(self, mask: torch.Tensor, other: "Relational") -> "Relational":
-        m = mask[:, None]
-        return Relational(**{s: torch.where(m, getattr(self, s), getattr(other, s)) for s in SLOTS})
+        return Relational(torch.where(mask[:, None], self.data, other.data))
+
+
+def _slot_property(slot):
+    a, b = _OFFSETS[slot]
+
+    def get(self):
+        return self.data[:, a:b]
+
+    def set(self, value):
+        self.data[:, a:b] = value
+    return property(get, set)
+
+
+for _s in SLOTS:
+    setattr(Relational, _s, _slot_property(_s))
 
 
 def relational_poses(root_p, root_q, hand_p, hand_q, obj_p, obj_q) -> Relational:
-    """World poses -> the six relational poses (quaternions with w >= 0)."""
-    x_oh, q_oh = relative_pose(hand_p, hand_q, obj_p, obj_q)
-    x_or, q_or = relative_pose(root_p, root_q, obj_p, obj_q)
-    x_hr, q_hr = relative_pose(root_p, root_q, hand_p, hand_q)
-    return Relational(x_oh, q_oh, x_or, q_or, x_hr, q_hr)
+    """World poses -> the six relational poses (quaternions with w >= 0), in one batched call."""
+    frame_p = torch.stack([hand_p, root_p, root_p], dim=1)
+    frame_q = torch.stack([hand_q, root_q, root_q], dim=1)
+    x, q = relative_pose(frame_p, frame_q, torch.stack([obj_p, obj_p, hand_p], dim=1),
+                         torch.stack([obj_q, obj_q, hand_q], dim=1))
+    return Relational.from_poses(x, q)
 
 
 @dataclasses.dataclass
@@ -254,14 +282,13 @@ def update_targets(mode: torch.Tensor, cur: Relational, init: Relational, final_
     return Relational(**c.out)
 
 
-FREE_BY_MODE = torch.tensor([[SKILL_TARGETS[mode_skill(m)][s] == "free" for s in SLOTS] for m in MODES])
+FREE_BY_MODE = torch.tensor([[SKILL_TARGETS[mode_skill(m)][s] == "free" for s in SLOTS for _ in range(SLOT_DIMS[s])]
+                             for m in MODES])  # [modes, 21]
 
 
 def with_free_as_current(mode: torch.Tensor, tgt: Relational, cur: Relational) -> Relational:
     """Targets where Free slots take the current value (their tracking error is zero)."""
-    free = FREE_BY_MODE.to(mode.device)[mode]
-    return Relational(**{s: torch.where(free[:, i:i + 1], getattr(cur, s), getattr(tgt, s))
-                         for i, s in enumerate(SLOTS)})
+    return Relational(torch.where(FREE_BY_MODE.to(mode.device)[mode], cur.data, tgt.data))
 
 
 def goal_features(mode: torch.Tensor, axis: torch.Tensor, cur: Relational, tgt: Relational,
@@ -290,8 +317,8 @@ def map_action(action: torch.Tensor, prev_command: torch.Tensor, wrist_ref: torc
 
 
 def finite_velocity(x_prev, q_prev, x_cur, q_cur, dt: float) -> Tuple[torch.Tensor, torch.Tensor]:
-    """Linear and angular velocity of a pose between two control steps, both expressed in the
-    pose's parent frame (e.g. the object's hand-frame velocity from x_oh, q_oh)."""
+    """Linear and angular velocity of poses between two control steps, both expressed in each
+    pose's parent frame (e.g. the object's hand-frame velocity from x_oh, q_oh). Any leading shape."""
     v = (x_cur - x_prev) / dt
     w = quat_to_axis_angle(quat_mul(q_cur, quat_inv(q_prev))) / dt
     return v, w

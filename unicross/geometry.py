@@ -11,7 +11,6 @@ import math
 import torch
 from mani_skill.utils.geometry.rotation_conversions import (
     euler_angles_to_matrix,
-    matrix_to_euler_angles,
     matrix_to_quaternion,
     quaternion_to_matrix,
 )
@@ -76,7 +75,14 @@ def quat_from_euler_xyz(e: torch.Tensor) -> torch.Tensor:
 
 
 def quat_to_euler_xyz(q: torch.Tensor) -> torch.Tensor:
-    return matrix_to_euler_angles(quaternion_to_matrix(q), "XYZ")
+    """Intrinsic XYZ Euler angles (a, b, c) with R = Rx(a) Ry(b) Rz(c), straight from the quaternion."""
+    w, x, y, z = q.unbind(-1)
+    r02 = 2 * (x * z + w * y)
+    r12 = 2 * (y * z - w * x)
+    r22 = 1 - 2 * (x * x + y * y)
+    r01 = 2 * (x * y - w * z)
+    r00 = 1 - 2 * (y * y + z * z)
+    return torch.stack([torch.atan2(-r12, r22), torch.asin(r02.clamp(-1.0, 1.0)), torch.atan2(-r01, r00)], dim=-1)
 
 
 def quat_from_axis_angle(axis: torch.Tensor, angle: torch.Tensor) -> torch.Tensor:

@@ -14,7 +14,7 @@ from typing import Dict
 
 import torch
 
-from unicross.formulation import MODES, SLOTS, Relational, mode_skill
+from unicross.formulation import MODES, Relational, mode_skill
 from unicross.geometry import quat_angle
 
 TRACK_WEIGHTS = dict(x_or="w_opr", q_or="w_oqr", x_oh="w_oph", q_oh="w_oqh", x_hr="w_hpr", q_hr="w_hqr")
@@ -32,14 +32,12 @@ def motion_reward(speed_along_axis: torch.Tensor, cap: torch.Tensor, w_p: torch.
     return w_p * torch.minimum(speed_along_axis, cap)
 
 
-def tracking_reward(cur: Relational, tgt: Relational, weights: Dict[str, float]) -> torch.Tensor:
-    """Σ w_pos·||x - x̂||² + w_rot·A(q, q̂) over the six relational poses."""
-    total = torch.zeros_like(cur.x_oh[:, 0])
-    for slot in SLOTS:
-        a, b = getattr(cur, slot), getattr(tgt, slot)
-        err = quat_angle(a, b) if slot.startswith("q") else ((a - b) ** 2).sum(-1)
-        total = total + weights[TRACK_WEIGHTS[slot]] * err
-    return total
+def tracking_reward(cur: Relational, tgt: Relational, w_pos: torch.Tensor, w_rot: torch.Tensor) -> torch.Tensor:
+    """Σ w_pos·||x - x̂||² + w_rot·A(q, q̂) over the three relational poses (o in h, o in r, h in r);
+    ``w_pos``/``w_rot`` are [3] weights in that order."""
+    xc, qc = cur.poses()
+    xt, qt = tgt.poses()
+    return (((xc - xt) ** 2).sum(-1) * w_pos).sum(-1) + (quat_angle(qc, qt) * w_rot).sum(-1)
 
 
 def pose_reward(finger_q: torch.Tensor, finger_q0: torch.Tensor, w_pose: float) -> torch.Tensor:
@@ -69,7 +67,9 @@ class RewardTerms:
         self.w_con = per_mode(lambda s: cfg["contact"][s]["w_con"])
         self.w_f = per_mode(lambda s: cfg["contact"][s]["w_f"])
         self.w_p = per_mode(lambda s: cfg["motion"][s])
-        self.track = dict(cfg["track"])
+        t = cfg["track"]
+        self.track_pos = torch.tensor([t[TRACK_WEIGHTS[s]] for s in ("x_oh", "x_or", "x_hr")], device=device)
+        self.track_rot = torch.tensor([t[TRACK_WEIGHTS[s]] for s in ("q_oh", "q_or", "q_hr")], device=device)
         self.reg = dict(cfg["reg"])
         self.no_track_reward = no_track_reward
 
@@ -79,7 +79,7 @@ class RewardTerms:
             contact=contact_reward(m["link_distance"], m["contact"].float(), m["force_clipped"],
                                    self.w_dis[mode], self.w_con[mode], self.w_f[mode]),
             motion=motion_reward(m["speed_along_axis"], m["speed_cap"], self.w_p[mode]),
-            track=tracking_reward(m["relational"], m["reward_targets"], self.track),
+            track=tracking_reward(m["relational"], m["reward_targets"], self.track_pos, self.track_rot),
             pose=pose_reward(m["finger_qpos"], m["finger_qpos0"], self.reg["w_pose"]),
             wrist_velocity=wrist_velocity_reward(m["hand_lin_vel"], m["hand_ang_vel"],
                                                  self.reg["w_vel"], self.reg["w_ang"]),

@@ -72,9 +72,9 @@ class HandObjectSensor:
 
     def apply_object_force(self, force) -> None:
         """External force [N, 3] (world, Newtons) on the object's centre of mass for the next sim
-        step: a tensor on the env device (GPU) or, on the CPU, a tensor or a numpy array."""
+        step: a tensor on the env device (GPU) or, on the CPU, a [N, 3] tensor or one float32 [3] array."""
         if self.gpu:
             self.scene.px.cuda_rigid_body_force.torch()[self._obj_index, :3] = force
             self.scene.px.gpu_apply_rigid_dynamic_force()
         else:
-            self._obj_body.add_force_torque(np.asarray(force[0], dtype=np.float32), self._zero3)
+            self._obj_body.add_force_torque(force[0].numpy() if isinstance(force, torch.Tensor) else force, self._zero3)
