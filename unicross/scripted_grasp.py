@@ -146,9 +146,10 @@ def hold_test(hand: str, grasps: GraspSet, objects: Sequence[ObjectSpec], second
     held = []
     by_name = {o.name: o for o in objects}
     for oi, name in enumerate(grasps.object_names):
-        if name not in by_name:
+        mask = grasps.data["object_id"] == oi
+        if name not in by_name or not bool(mask.any()):
             continue
-        sub = GraspSet(hand, [name], grasps.data[grasps.data["object_id"] == oi], grasps.source)
+        sub = GraspSet(hand, [name], grasps.data[mask], grasps.source)
         sub.data["object_id"] = torch.zeros_like(sub.data["object_id"])
         env = gym.make("UniCross-Relocate-v1", obs_mode="none", sim_backend="physx_cpu", render_backend="none",
                        hand=hand, objects=[by_name[name]], randomize=randomize, grasp_dataset=sub,
