@@ -1,7 +1,8 @@
 """Control steps/s of every UniCross task id on the CPU, and the ratio to bare physics.
 
-For each id the env steps with zero actions from a reset (relocate/rotate/translate start from a
-grasp, so the hand holds the object; grasp runs the scripted grasp first so the hand holds it too)
+For each id the env steps with small random wrist actions and still fingers from a reset
+(relocate/rotate/translate start from a grasp, so the hand holds the object; grasp runs the
+scripted grasp first so the hand holds it too)
 and we time (a) ``env.step`` and (b) bare physics of the same scene: the same number of PhysX
 substeps per control step with no task code. Both are measured in this one run, interleaved, and
 reported as steps/s and as a ratio.
@@ -46,9 +47,11 @@ def _holding_env(task, kw, grasps, objects, **extra):
 
 
 def _time_env(u, steps, seed=0):
-    """env.step with small random actions; returns (steps/s, joint commands, mean links in contact)."""
+    """env.step with small random wrist actions and fingers holding their grip (the hand keeps the
+    object and every body stays awake); returns (steps/s, joint commands, joints, mean links in contact)."""
     g = torch.Generator().manual_seed(seed)
-    actions = (torch.rand(steps, 1, u.hand_spec.dof, generator=g) * 2 - 1) * 0.3
+    actions = torch.zeros(steps, 1, u.hand_spec.dof)
+    actions[..., :6] = (torch.rand(steps, 1, 6, generator=g) * 2 - 1) * 0.3
     commands, contacts = [], 0
     t = time.perf_counter()
     for i in range(steps):
