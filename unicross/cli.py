@@ -3,6 +3,7 @@
     unicross info                         task ids, observation/action sizes, the target table
     unicross grasps --objects SET ...     synthesise a grasp-state dataset (scripted) and hold-test it
     unicross rollout --task ID ...        run random or zero actions and print per-term rewards
+    unicross train --skill SKILL ...      train one expert with PPO (resumable)
 
 Bad input (unknown skill/axis/hand/object set, missing files) fails before any simulation.
 """
@@ -96,6 +97,48 @@ def _cmd_rollout(args) -> int:
     return 0
 
 
+def parse_sets(items) -> dict:
+    """``section.key=value`` strings -> nested dict (values parsed as YAML)."""
+    import yaml
+    out: dict = {}
+    for item in items or []:
+        if "=" not in item:
+            raise ValueError(f"--set expects section.key=value, got {item!r}")
+        path, value = item.split("=", 1)
+        node = out
+        keys = path.split(".")
+        for k in keys[:-1]:
+            node = node.setdefault(k, {})
+        node[keys[-1]] = yaml.safe_load(value)
+    return out
+
+
+def _cmd_train(args) -> int:
+    from unicross.rl.ppo import PPOTrainer
+    overrides = parse_sets(args.set)
+    scale = {}
+    if args.num_envs is not None:
+        scale.setdefault("env", {})["num_envs"] = args.num_envs
+    if args.backend is not None:
+        scale.setdefault("env", {})["backend"] = args.backend
+    if args.total_frames is not None:
+        scale.setdefault("collector", {})["total_frames"] = args.total_frames
+    for section, values in scale.items():  # the scale flags win over --set
+        overrides.setdefault(section, {}).update(values)
+    if not args.resume and args.skill is None:
+        raise ValueError("--skill is required (grasp, relocate, rotate, translate)")
+    trainer = PPOTrainer(args.out, args.skill or "grasp", args.axis, args.hand, overrides=overrides or None,
+                         resume=args.resume)
+    try:
+        summary = trainer.train(max_iterations=args.max_iterations)
+    finally:
+        trainer.close()
+    for k, v in summary.items():
+        print(f"{k}: " + ", ".join(f"{a}={b:.4g}" if isinstance(b, float) else f"{a}={b}" for a, b in v.items()))
+    print(f"checkpoint: {trainer.run_dir / 'checkpoint.pt'} (iteration {trainer.iteration}, {trainer.frames} frames)")
+    return 0
+
+
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(prog="unicross", description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = p.add_subparsers(dest="cmd", required=True)
@@ -124,10 +167,23 @@ def main(argv=None) -> int:
     s.add_argument("--seed", type=int, default=0)
     s.add_argument("--zero", action="store_true", help="zero actions instead of random ones")
     s.set_defaults(fn=_cmd_rollout)
+    s = sub.add_parser("train", help="train one expert with PPO (TorchRL); resumable")
+    s.add_argument("--skill", choices=["grasp", "relocate", "rotate", "translate"], default=None)
+    s.add_argument("--axis", default=None, help="rotate: x+,x-,y+,y-,z+,z-; translate: z+,z-")
+    s.add_argument("--direction", dest="axis", help=argparse.SUPPRESS)
+    s.add_argument("--hand", default="allegro")
+    s.add_argument("--out", required=True, help="run directory (checkpoint, metrics.csv, metrics.jsonl, tb/)")
+    s.add_argument("--num-envs", type=int, default=None)
+    s.add_argument("--total-frames", type=int, default=None)
+    s.add_argument("--backend", choices=["physx_cpu", "physx_cuda"], default=None)
+    s.add_argument("--max-iterations", type=int, default=None, help="stop (and checkpoint) after this many iterations")
+    s.add_argument("--set", action="append", metavar="SECTION.KEY=VALUE", help="override configs/ppo.yaml")
+    s.add_argument("--resume", action="store_true", help="continue the run in --out from its checkpoint")
+    s.set_defaults(fn=_cmd_train)
     args = p.parse_args(argv)
     try:
         return args.fn(args)
-    except (ValueError, FileNotFoundError, KeyError) as e:
+    except (ValueError, FileNotFoundError, FileExistsError, KeyError) as e:
         print(f"unicross {args.cmd}: error: {e}", file=sys.stderr)
         return 2
 

@@ -1,0 +1,145 @@
+"""A TorchRL environment over a batched ManiSkill UniCross task.
+
+``ManiSkillEnv`` keeps tensors on the env device, exposes the observation groups as TensorDict
+keys (``hand``, ``object``, ``goal``), reports ``terminated`` (object dropped) and ``truncated``
+(episode length reached) separately, carries the task's per-term rewards and success flags under
+``info``, and supports partial resets (``_reset`` masks) on the GPU backend.
+
+On the CPU, SAPIEN simulates one env per process: :func:`make_env` then builds a ``ParallelEnv``
+of single-env workers (batch ``[W]``). On the GPU it builds one env with many sub-scenes
+(``physx_cuda``, batch ``[N]``). Both give the same keys and shapes per env.
+"""
+from __future__ import annotations
+
+from typing import Optional
+
+import torch
+from tensordict import TensorDict, TensorDictBase
+from torchrl.data import Bounded, Categorical, Composite, Unbounded
+from torchrl.envs import EnvBase
+
+INFO_FLOAT = ("rotation", "translation", "relocate_pos_err", "relocate_rot_err", "reward_contact", "reward_motion",
+              "reward_track", "reward_pose", "reward_wrist_velocity", "reward_energy", "reward_drop")
+INFO_BOOL = ("success", "drop")
+
+
+class ManiSkillEnv(EnvBase):
+    """TorchRL ``EnvBase`` over ``gym.make(env_id, obs_mode="state_dict", **env_kwargs)``.
+
+    With ``num_envs == 1`` the batch dimension is squeezed (batch_size ``[]``), so that a
+    ``ParallelEnv`` of CPU workers has batch ``[W]`` like a GPU env of ``W`` sub-scenes.
+    """
+
+    def __init__(self, env_id: str, env_kwargs: Optional[dict] = None, device=None):
+        import gymnasium as gym
+        import unicross  # noqa: F401  (registers the tasks)
+        kw = dict(obs_mode="state_dict", render_backend="none")
+        kw.update(env_kwargs or {})
+        kw["obs_mode"] = "state_dict"
+        self._gym = gym.make(env_id, **kw)
+        self.task = self._gym.unwrapped
+        n = self.task.num_envs
+        self._squeeze = n == 1
+        batch = torch.Size([]) if self._squeeze else torch.Size([n])
+        super().__init__(device=self.task.device, batch_size=batch)
+        self.env_id = env_id
+        self._seed: Optional[int] = None
+        self._make_specs()
+
+    # ------------------------------------------------------------------ specs
+    def _make_specs(self):
+        b = self.batch_size
+        obs = self.task.get_obs(unflattened=True)["extra"]
+        dims = dict(hand=obs["hand"].shape[-1], goal=obs["goal"].shape[-1],
+                    object=sum(v.shape[-1] for v in obs["object"].values()))
+        dev = self.device
+        info = Composite({k: Unbounded(b + (1,), device=dev) for k in INFO_FLOAT}, shape=b, device=dev)
+        for k in INFO_BOOL:
+            info[k] = Categorical(2, b + (1,), dtype=torch.bool, device=dev)
+        self.observation_spec = Composite(hand=Unbounded(b + (dims["hand"],), device=dev),
+                                          object=Unbounded(b + (dims["object"],), device=dev),
+                                          goal=Unbounded(b + (dims["goal"],), device=dev),
+                                          info=info, shape=b, device=dev)
+        n_act = self.task.single_action_space.shape[0]
+        self.action_spec = Bounded(-1.0, 1.0, b + (n_act,), device=dev)
+        self.reward_spec = Unbounded(b + (1,), device=dev)
+        self.done_spec = Composite(done=Categorical(2, b + (1,), dtype=torch.bool, device=dev),
+                                   terminated=Categorical(2, b + (1,), dtype=torch.bool, device=dev),
+                                   truncated=Categorical(2, b + (1,), dtype=torch.bool, device=dev),
+                                   shape=b, device=dev)
+
+    # ------------------------------------------------------------------ conversions
+    def _pack(self, obs: dict, info: dict) -> TensorDict:
+        o = obs["extra"]
+        td = {
+            "hand": o["hand"],
+            "object": torch.cat([o["object"]["contact"], o["object"]["force"], o["object"]["distance"]], dim=-1),
+            "goal": o["goal"],
+            "info": {k: info[k].reshape(-1, 1).float() for k in INFO_FLOAT}
+            | {k: info[k].reshape(-1, 1).bool() for k in INFO_BOOL},
+        }
+        td = TensorDict(td, batch_size=[self.task.num_envs], device=self.device)
+        return td[0] if self._squeeze else td
+
+    # ------------------------------------------------------------------ EnvBase hooks
+    def _reset(self, tensordict: Optional[TensorDictBase] = None, **kwargs) -> TensorDictBase:
+        options = {}
+        if tensordict is not None and "_reset" in tensordict.keys() and not self._squeeze:
+            mask = tensordict["_reset"].reshape(-1)
+            if not bool(mask.all()):
+                options["env_idx"] = torch.nonzero(mask).flatten()
+        seed, self._seed = self._seed, None
+        obs, info = self.task.reset(seed=seed, options=options)
+        info = dict(info)
+        n = self.task.num_envs
+        for k in INFO_FLOAT + INFO_BOOL:
+            info.setdefault(k, torch.zeros(n, device=self.device))
+        td = self._pack(obs, info)
+        zeros = torch.zeros(self.batch_size + (1,), dtype=torch.bool, device=self.device)
+        td.update({"done": zeros, "terminated": zeros.clone(), "truncated": zeros.clone()})
+        return td
+
+    def _step(self, tensordict: TensorDictBase) -> TensorDictBase:
+        action = tensordict["action"]
+        if self._squeeze:
+            action = action.unsqueeze(0)
+        obs, reward, terminated, truncated, info = self.task.step(action)
+        td = self._pack(obs, info)
+        shape = self.batch_size + (1,)
+        td.update({"reward": reward.reshape(shape).float(), "terminated": terminated.reshape(shape),
+                   "truncated": truncated.reshape(shape), "done": (terminated | truncated).reshape(shape)})
+        return td
+
+    def _set_seed(self, seed: Optional[int]):
+        self._seed = seed
+        return seed
+
+    def close(self, *, raise_if_closed: bool = True):
+        self._gym.close()
+        super().close(raise_if_closed=raise_if_closed)
+
+
+def make_env(env_id: str, env_kwargs: Optional[dict] = None, num_envs: int = 1, backend: str = "physx_cpu",
+             workers: Optional[int] = None):
+    """CPU: ``ParallelEnv`` of ``num_envs`` single-env worker processes (or one in-process env when
+    ``num_envs == 1``); GPU: one ``physx_cuda`` env with ``num_envs`` sub-scenes."""
+    from torchrl.envs import EnvCreator, ParallelEnv
+    kw = dict(env_kwargs or {})
+    if backend == "physx_cuda":
+        kw.update(sim_backend="physx_cuda", num_envs=num_envs)
+        return ManiSkillEnv(env_id, kw)
+    kw.update(sim_backend="physx_cpu", num_envs=1)
+    if num_envs == 1:
+        return ManiSkillEnv(env_id, kw)
+    return ParallelEnv(num_envs, EnvCreator(_Factory(env_id, kw)), mp_start_method="spawn")
+
+
+class _Factory:
+    """Picklable env factory for worker processes."""
+
+    def __init__(self, env_id, kw):
+        self.env_id, self.kw = env_id, kw
+
+    def __call__(self):
+        torch.set_num_threads(1)
+        return ManiSkillEnv(self.env_id, self.kw)
