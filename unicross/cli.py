@@ -44,7 +44,14 @@ def _cmd_grasps(args) -> int:
     objs = get_object_set(args.objects, limit=args.limit)
     out = Path(args.out)
     t0 = time.time()
-    gs, stats = synthesize(args.hand, objs, args.per_object, seed=args.seed)
+    if args.expert:
+        from unicross.rl.expert_grasps import expert_grasps
+        from unicross.rl.policy_io import load_policy
+        _, ck = load_policy(args.expert)  # fails fast on a missing/invalid checkpoint
+        args.hand = ck["hand"]
+        gs, stats = expert_grasps(args.expert, objs, args.per_object, seed=args.seed)
+    else:
+        gs, stats = synthesize(args.hand, objs, args.per_object, seed=args.seed)
     if args.append and out.exists():
         gs = GraspSet.merge([GraspSet.load(out), gs])
     gs.save(out)
@@ -55,7 +62,7 @@ def _cmd_grasps(args) -> int:
                    hold_2s_rate=round(sum(held) / len(held), 4) if held else None,
                    per_object=gs.counts(), seconds=round(took, 1))
     print(f"wrote {len(gs)} grasps of {len(objs)} objects to {out} in {took:.0f}s; "
-          f"scripted success {stats['success_rate']:.1%}"
+          f"{'expert' if args.expert else 'scripted'} success {stats['success_rate']:.1%}"
           + (f"; restored grasps holding for 2 s: {sum(held)}/{len(held)} = {sum(held) / len(held):.1%}" if held else ""))
     short = [n for n, c in gs.counts().items() if c < args.per_object]
     if short:
@@ -145,7 +152,8 @@ def main(argv=None) -> int:
     s = sub.add_parser("info", help="print task ids, sizes and the target table")
     s.add_argument("--hand", default="allegro")
     s.set_defaults(fn=_cmd_info)
-    s = sub.add_parser("grasps", help="synthesise a grasp-state dataset with the scripted synthesiser")
+    s = sub.add_parser("grasps", help="build a grasp-state dataset (grasp expert, or the scripted synthesiser)")
+    s.add_argument("--expert", default=None, help="grasp expert checkpoint (default: the scripted synthesiser)")
     s.add_argument("--objects", default="train", help="object set (train, test-wrappable, unseen, mesh:<file>, ...)")
     s.add_argument("--limit", type=int, default=None, help="first N objects of each (category, type) group")
     s.add_argument("--per-object", type=int, default=5)
@@ -183,7 +191,7 @@ def main(argv=None) -> int:
     args = p.parse_args(argv)
     try:
         return args.fn(args)
-    except (ValueError, FileNotFoundError, FileExistsError, KeyError) as e:
+    except (ValueError, FileNotFoundError, FileExistsError, KeyError, RuntimeError) as e:
         print(f"unicross {args.cmd}: error: {e}", file=sys.stderr)
         return 2
 

@@ -116,12 +116,8 @@ def synthesize(hand: str, objects: Sequence[ObjectSpec], per_object: int, seed: 
             for e in torch.nonzero(ok).flatten().tolist():
                 if kept[obj.name] >= per_object:
                     break
-                pos, quat = u.sensor.poses()
-                rows["finger_qpos"].append(info_q(u)[e, 6:].cpu().clone())
-                rows["finger_target"].append(u.command[e, 6:].cpu().clone())
-                rows["wrist_pose"].append(torch.cat([pos[e, 0], quat[e, 0]]).cpu().clone())
-                rows["object_pose_hand"].append(torch.cat([u.cur_rel.x_oh[e], u.cur_rel.q_oh[e]]).cpu().clone())
-                rows["object_id"].append(torch.tensor(oi))
+                for k, v in grasp_state(u, e, oi).items():
+                    rows[k].append(v)
                 kept[obj.name] += 1
                 bar.update(1)
         env.close()
@@ -133,8 +129,14 @@ def synthesize(hand: str, objects: Sequence[ObjectSpec], per_object: int, seed: 
     return GraspSet(hand, names, data, source="scripted"), stats
 
 
-def info_q(u) -> torch.Tensor:
-    return u.agent.robot.get_qpos()[:, u._qidx]
+def grasp_state(u, e: int, object_id: int) -> dict:
+    """The grasp-dataset row of env ``e`` of the unwrapped task ``u`` (copies, on the CPU)."""
+    pos, quat = u.sensor.poses()
+    q = u.agent.robot.get_qpos()[:, u._qidx]
+    return dict(finger_qpos=q[e, 6:].cpu().clone(), finger_target=u.command[e, 6:].cpu().clone(),
+                wrist_pose=torch.cat([pos[e, 0], quat[e, 0]]).cpu().clone(),
+                object_pose_hand=torch.cat([u.cur_rel.x_oh[e], u.cur_rel.q_oh[e]]).cpu().clone(),
+                object_id=torch.tensor(object_id))
 
 
 def hold_test(hand: str, grasps: GraspSet, objects: Sequence[ObjectSpec], seconds: float = 2.0,

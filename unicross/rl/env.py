@@ -23,6 +23,14 @@ INFO_FLOAT = ("rotation", "translation", "relocate_pos_err", "relocate_rot_err",
 INFO_BOOL = ("success", "drop")
 
 
+def obs_to_td(obs: dict, device=None) -> TensorDict:
+    """A UniCross ``state_dict`` observation -> TensorDict with keys hand, object, goal ([N, ...])."""
+    o = obs["extra"]
+    obj = torch.cat([o["object"]["contact"], o["object"]["force"], o["object"]["distance"]], dim=-1)
+    return TensorDict({"hand": o["hand"], "object": obj, "goal": o["goal"]}, batch_size=[o["hand"].shape[0]],
+                      device=device)
+
+
 class ManiSkillEnv(EnvBase):
     """TorchRL ``EnvBase`` over ``gym.make(env_id, obs_mode="state_dict", **env_kwargs)``.
 
@@ -70,15 +78,9 @@ class ManiSkillEnv(EnvBase):
 
     # ------------------------------------------------------------------ conversions
     def _pack(self, obs: dict, info: dict) -> TensorDict:
-        o = obs["extra"]
-        td = {
-            "hand": o["hand"],
-            "object": torch.cat([o["object"]["contact"], o["object"]["force"], o["object"]["distance"]], dim=-1),
-            "goal": o["goal"],
-            "info": {k: info[k].reshape(-1, 1).float() for k in INFO_FLOAT}
-            | {k: info[k].reshape(-1, 1).bool() for k in INFO_BOOL},
-        }
-        td = TensorDict(td, batch_size=[self.task.num_envs], device=self.device)
+        td = obs_to_td(obs, self.device)
+        td["info"] = TensorDict({k: info[k].reshape(-1, 1).float() for k in INFO_FLOAT}
+                                | {k: info[k].reshape(-1, 1).bool() for k in INFO_BOOL}, batch_size=td.batch_size)
         return td[0] if self._squeeze else td
 
     # ------------------------------------------------------------------ EnvBase hooks

@@ -1,0 +1,61 @@
+"""The grasp-state dataset from a trained grasp expert (the paper's relocate/rotate/translate starts).
+
+The expert runs ``UniCross-Grasp-v1`` (with its lift phase) on each object; a grasp is kept when
+the episode succeeds (lifted, never dropped) and the object is settled in the hand at the end
+(hand-frame speed below ``settle_speed``). Rows are written in the format of
+:mod:`unicross.grasps`, the one the tasks read and the scripted synthesiser writes.
+"""
+from __future__ import annotations
+
+from typing import Sequence
+
+import gymnasium as gym
+import torch
+from tensordict import TensorDict
+from tqdm import tqdm
+
+from unicross.grasps import GraspSet
+from unicross.objects import ObjectSpec
+from unicross.rl.policy_io import act, load_policy
+from unicross.scripted_grasp import grasp_state
+
+
+def expert_grasps(ckpt_path, objects: Sequence[ObjectSpec], per_object: int, seed: int = 0,
+                  max_tries: int | None = None, settle_speed: float = 0.05, progress: bool = True):
+    import unicross  # noqa: F401
+    policy, ck = load_policy(ckpt_path)
+    if ck.get("skill") != "grasp":
+        raise ValueError(f"{ckpt_path} is a {ck.get('skill')!r} expert, not a grasp expert")
+    hand = ck["hand"]
+    max_tries = max_tries or 4 * per_object
+    rows = {k: [] for k in ("finger_qpos", "finger_target", "wrist_pose", "object_pose_hand", "object_id")}
+    tried, kept = {}, {}
+    bar = tqdm(total=len(objects) * per_object, desc="expert grasps", disable=not progress)
+    for oi, obj in enumerate(objects):
+        env = gym.make("UniCross-Grasp-v1", obs_mode="state_dict", sim_backend="physx_cpu", render_backend="none",
+                       hand=hand, objects=[obj], randomize=False)
+        u = env.unwrapped
+        length = int(u.episode_length[0])
+        tried[obj.name] = kept[obj.name] = 0
+        while kept[obj.name] < per_object and tried[obj.name] < max_tries:
+            obs, _ = u.reset(seed=seed * 100003 + oi * 1009 + tried[obj.name])
+            info = None
+            for _ in range(length):
+                obs, _, term, _, info = u.step(act(policy, obs))
+                if bool(term.all()):
+                    break
+            tried[obj.name] += 1
+            settled = (u.obj_vel_h.norm(dim=-1) < settle_speed) & (u.obj_angvel_h.norm(dim=-1) < 10 * settle_speed)
+            ok = info["success"] & ~info["ever_dropped"] & settled
+            if bool(ok[0]):
+                for k, v in grasp_state(u, 0, oi).items():
+                    rows[k].append(v)
+                kept[obj.name] += 1
+                bar.update(1)
+        env.close()
+    bar.close()
+    if not rows["object_id"]:
+        raise RuntimeError(f"the expert {ckpt_path} produced no successful, settled grasp")
+    data = TensorDict({k: torch.stack(v) for k, v in rows.items()}, batch_size=[len(rows["object_id"])])
+    stats = dict(tried=tried, kept=kept, success_rate=sum(kept.values()) / max(1, sum(tried.values())))
+    return GraspSet(hand, [o.name for o in objects], data, source=f"expert:{ckpt_path}"), stats
