@@ -253,6 +253,7 @@ class UniCrossEnv(BaseEnv):
         self.obj_z0 = torch.zeros(n, device=dev)
         self.lift = z3.clone()
         self.perturb = z3.clone()
+        self.disturb = z3.clone()
         self.obs_noise = torch.zeros(n, dof, device=dev)
         self.obj_vel_h = z3.clone()
         self.obj_angvel_h = z3.clone()
@@ -358,6 +359,11 @@ class UniCrossEnv(BaseEnv):
         self.lift[env_idx] = 0
         self.perturb[env_idx] = 0
         self.link_force[env_idx] = 0
+        dmax = self.cfg["disturbance"]["max_scale"]
+        if dmax > 0:  # constant force: random direction, magnitude U[0, dmax * m * g]
+            direction = torch.nn.functional.normalize(torch.randn(b, 3, generator=g, device=dev), dim=-1)
+            mag = torch.rand(b, generator=g, device=dev) * dmax * self.obj_mass[env_idx] * 9.81
+            self.disturb[env_idx] = direction * mag[:, None]
         for t in (self.obj_vel_h, self.obj_angvel_h, self.hand_vel, self.hand_angvel):
             t[env_idx] = 0
         self._pending[env_idx] = True
@@ -409,15 +415,38 @@ class UniCrossEnv(BaseEnv):
         up_root = quat_apply(quat_inv(self.root_q), self._world_up.expand_as(self.lift))
         self.lift = self.lift + lifting[:, None].float() * up_root * self.cfg["grasp"]["lift_speed"] * self.control_dt
 
-    def _before_simulation_step(self):
+    def _before_control_step(self):
+        """This control step's external object forces for all substeps at once: the decaying random
+        perturbation (domain randomisation) plus the constant disturbance of the robustness protocol
+        (for grasp only while lifting)."""
         rc = self.cfg["randomization"]
-        if not rc["enabled"] or rc["perturb_scale"] == 0:
-            return
-        n = self.num_envs
-        new = rc["perturb_scale"] * self.obj_mass[:, None] * torch.randn(n, 3, generator=self._gen, device=self.device)
-        redraw = torch.rand(n, 1, generator=self._gen, device=self.device) < rc["perturb_prob"]
-        self.perturb = torch.where(redraw, new, self.perturb * rc["perturb_decay"])
-        self.sensor.apply_object_force(self.perturb)
+        k, n = self._sim_steps_per_control, self.num_envs
+        self._substep = 0
+        self._forces = None
+        forces = None
+        if rc["enabled"] and rc["perturb_scale"] > 0:
+            new = rc["perturb_scale"] * self.obj_mass[:, None] * torch.randn(k, n, 3, generator=self._gen, device=self.device)
+            redraw = torch.rand(k, n, 1, generator=self._gen, device=self.device) < rc["perturb_prob"]
+            f, steps = self.perturb, []
+            for i in range(k):  # the decay recursion over the substeps of one control step
+                f = torch.where(redraw[i], new[i], f * rc["perturb_decay"])
+                steps.append(f)
+            self.perturb = f
+            forces = torch.stack(steps)
+        if self.cfg["disturbance"]["max_scale"] > 0:
+            active = torch.ones(n, 1, dtype=torch.bool, device=self.device)
+            lift_after = self.cfg["grasp"]["lift_after"]
+            if lift_after is not None:
+                active = ((self.mode != 0) | (self.elapsed_steps >= lift_after))[:, None]
+            disturb = torch.where(active, self.disturb, torch.zeros_like(self.disturb))
+            forces = disturb.expand(k, n, 3) if forces is None else forces + disturb
+        if forces is not None:
+            self._forces = forces if self.gpu_sim_enabled else list(forces[:, 0].numpy())
+
+    def _before_simulation_step(self):
+        if self._forces is not None:
+            self.sensor.apply_object_force(self._forces[self._substep])
+        self._substep += 1
 
     # ------------------------------------------------------------------ evaluation (single source of truth)
     def _measure(self) -> Dict[str, torch.Tensor]:
@@ -544,7 +573,7 @@ class UniCrossEnv(BaseEnv):
     # ------------------------------------------------------------------ state (sim + task)
     _TASK_STATE = ("root_p", "root_q", "init_rel", "targets", "prev_rel", "final_x_or", "final_q_or", "axis",
                    "command", "finger_q0", "rot_acc", "trans_acc", "ever_dropped", "obj_z0", "lift", "perturb",
-                   "obs_noise", "obj_vel_h", "obj_angvel_h", "hand_vel", "hand_angvel", "link_force", "mode")
+                   "obs_noise", "obj_vel_h", "obj_angvel_h", "hand_vel", "hand_angvel", "link_force", "disturb", "mode")
 
     def _task_state(self) -> Dict[str, torch.Tensor]:
         out = {}
