@@ -305,6 +305,11 @@ class UniCrossEnv(BaseEnv):
         if self.grasps is not None:
             gs = self.grasps.sample(self.obj_index[env_idx], [o.name for o in self.object_specs], g)
             random_q = _random_quaternion(b, g, dev)
+            if self.cfg["in_hand_orientation"] == "palm_up":  # palm normal (+x_h) up, random yaw
+                psi = torch.rand(b, generator=g, device=dev) * 2 * math.pi
+                xu = torch.tensor([0.0, 0.0, 1.0], device=dev).expand(b, 3)
+                zu = torch.stack([torch.cos(psi), torch.sin(psi), torch.zeros_like(psi)], -1)
+                random_q = quat_from_matrix(torch.stack([xu, torch.cross(zu, xu, dim=-1), zu], dim=-1))
             world_q = torch.where((skill == F.SKILLS.index("relocate"))[:, None], gs["wrist_pose"][:, 3:], random_q)
             world_p = gs["wrist_pose"][:, :3].clone()
             inhand_h = self.cfg["in_hand_start_height"]

@@ -4,6 +4,8 @@
     unicross grasps --objects SET ...     synthesise a grasp-state dataset (scripted) and hold-test it
     unicross rollout --task ID ...        run random or zero actions and print per-term rewards
     unicross train --skill SKILL ...      train one expert with PPO (resumable)
+    unicross eval --policy P ...          the paper's evaluation protocols -> JSON + table
+    unicross report FILES...              assemble eval results into the paper's tables
 
 Bad input (unknown skill/axis/hand/object set, missing files) fails before any simulation.
 """
@@ -146,6 +148,53 @@ def _cmd_train(args) -> int:
     return 0
 
 
+def _cmd_eval(args) -> int:
+    from unicross import evaluation as E
+    from unicross.objects import get_object_set
+    protocols = list(E.PROTOCOLS) if args.protocol == "all" else args.protocol.split(",")
+    bad = [p for p in protocols if p not in E.PROTOCOLS]
+    if bad:
+        raise ValueError(f"unknown protocol(s) {bad}; valid: {list(E.PROTOCOLS)} or 'all'")
+    objs = get_object_set(args.objects, limit=args.limit)
+    policy, desc = E.resolve_policy(args.policy, args.hand, seed=args.seed)
+    label = args.label or Path(args.policy).stem
+    result = dict(label=label, policy=desc, objects=args.objects, limit=args.limit, hand=args.hand,
+                  trials_per_object=args.trials_per_object, seed=args.seed, disturb=args.disturb,
+                  original=args.original, randomize=args.randomize, summaries={}, trials={})
+    for p in protocols:
+        trials = E.run_protocol(p, policy, objs, hand=args.hand, trials_per_object=args.trials_per_object,
+                                seed=args.seed, disturb=args.disturb, randomize=args.randomize,
+                                grasp_dataset=args.grasps, original=args.original)
+        result["trials"][p] = trials
+        result["summaries"][p] = E.summarize(p, trials)
+    out = Path(args.out)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    out.write_text(json.dumps(result, indent=1))
+    table = E.markdown_table({label: result["summaries"]})
+    out.with_suffix(".md").write_text(table + "\n")
+    print(table)
+    print(f"wrote {out} and {out.with_suffix('.md')}")
+    return 0
+
+
+def _cmd_report(args) -> int:
+    from unicross import evaluation as E
+    rows: dict = {}
+    for f in args.files:
+        r = json.loads(Path(f).read_text())
+        if "summaries" not in r:
+            raise ValueError(f"{f} is not a `unicross eval` result")
+        label = r["label"] + (" (Dis.)" if r.get("disturb") else "") + (" (Ori.)" if r.get("original") else "")
+        rows.setdefault(label, {}).update(r["summaries"])
+    table = E.markdown_table(rows)
+    if args.title:
+        table = f"**{args.title}**\n\n" + table
+    print(table)
+    if args.out:
+        Path(args.out).write_text(table + "\n")
+    return 0
+
+
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(prog="unicross", description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = p.add_subparsers(dest="cmd", required=True)
@@ -175,6 +224,27 @@ def main(argv=None) -> int:
     s.add_argument("--seed", type=int, default=0)
     s.add_argument("--zero", action="store_true", help="zero actions instead of random ones")
     s.set_defaults(fn=_cmd_rollout)
+    s = sub.add_parser("eval", help="run the paper's evaluation protocols; writes JSON (every trial) and a table")
+    s.add_argument("--policy", required=True, help="checkpoint path, or zero | random | scripted-relocate")
+    s.add_argument("--protocol", default="all", help="grasp, relocate, rotate, translate (comma list) or all")
+    s.add_argument("--objects", default="test", help="object set: train | test | unseen (| -wrappable/-elongated | mesh:<file>)")
+    s.add_argument("--limit", type=int, default=None, help="first N objects per (category, type) group")
+    s.add_argument("--trials-per-object", type=int, default=25)
+    s.add_argument("--disturb", action="store_true", help="constant random force U[0, 10 m g] on the object")
+    s.add_argument("--original", action="store_true",
+                   help="baselines' original settings: no table (grasp), palm up and fixed wrist (rotate/translate)")
+    s.add_argument("--randomize", action="store_true", help="keep domain randomisation on during evaluation")
+    s.add_argument("--grasps", default=None, help="grasp-state dataset (default: the shipped one)")
+    s.add_argument("--hand", default="allegro")
+    s.add_argument("--seed", type=int, default=0)
+    s.add_argument("--label", default=None, help="row label in tables (default: the policy name)")
+    s.add_argument("--out", required=True)
+    s.set_defaults(fn=_cmd_eval)
+    s = sub.add_parser("report", help="assemble eval JSON files into the paper's table layout")
+    s.add_argument("files", nargs="+")
+    s.add_argument("--title", default=None)
+    s.add_argument("--out", default=None)
+    s.set_defaults(fn=_cmd_report)
     s = sub.add_parser("train", help="train one expert with PPO (TorchRL); resumable")
     s.add_argument("--skill", choices=["grasp", "relocate", "rotate", "translate"], default=None)
     s.add_argument("--axis", default=None, help="rotate: x+,x-,y+,y-,z+,z-; translate: z+,z-")

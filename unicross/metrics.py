@@ -14,22 +14,38 @@ import torch
 from unicross.geometry import quat_angle, quat_inv, quat_mul, quat_to_axis_angle
 
 
-def accumulated_rotation(q_oh: torch.Tensor, axis: torch.Tensor) -> torch.Tensor:
-    """Signed rotation (rad) of the object about ``axis`` (hand frame) accumulated over a
-    trajectory of hand-frame orientations ``q_oh`` [B, T, 4]; axis [B, 3] or [3].
+def rotation_series(q_oh: torch.Tensor, axis: torch.Tensor) -> torch.Tensor:
+    """Signed rotation (rad) about ``axis`` (hand frame) accumulated up to each step of a
+    trajectory of hand-frame orientations ``q_oh`` [B, T, 4]; axis [B, 3] or [3]. Returns [B, T]
+    starting at 0.
 
     Sums the per-step incremental rotations projected on the axis, so it keeps counting past
     ±pi (a full turn gives 2*pi, not 0)."""
     dq = quat_mul(q_oh[:, 1:], quat_inv(q_oh[:, :-1]))
-    rv = quat_to_axis_angle(dq)  # [B, T-1, 3], each increment in (-pi, pi]
     axis = axis.expand(q_oh.shape[0], 3) if axis.ndim == 1 else axis
-    return (rv * axis[:, None]).sum(-1).sum(-1)
+    inc = (quat_to_axis_angle(dq) * axis[:, None]).sum(-1)  # [B, T-1], each increment in (-pi, pi]
+    return torch.cat([torch.zeros_like(inc[:, :1]), torch.cumsum(inc, dim=1)], dim=1)
+
+
+def accumulated_rotation(q_oh: torch.Tensor, axis: torch.Tensor) -> torch.Tensor:
+    """Total signed rotation (rad) about ``axis`` over the trajectory: [B]."""
+    return rotation_series(q_oh, axis)[:, -1]
+
+
+def translation_series(x_oh: torch.Tensor, axis: torch.Tensor) -> torch.Tensor:
+    """Signed displacement (m) along ``axis`` of the hand-frame object position [B, T, 3] from
+    its first value, at each step: [B, T]."""
+    axis = axis.expand(x_oh.shape[0], 3) if axis.ndim == 1 else axis
+    return ((x_oh - x_oh[:, :1]) * axis[:, None]).sum(-1)
 
 
 def accumulated_translation(x_oh: torch.Tensor, axis: torch.Tensor) -> torch.Tensor:
-    """Signed displacement (m) along ``axis`` of the hand-frame object position [B, T, 3]."""
-    axis = axis.expand(x_oh.shape[0], 3) if axis.ndim == 1 else axis
-    return ((x_oh[:, -1] - x_oh[:, 0]) * axis).sum(-1)
+    return translation_series(x_oh, axis)[:, -1]
+
+
+def exceeded(series: torch.Tensor, threshold: float) -> torch.Tensor:
+    """Whether the accumulated motion went beyond ``threshold`` at any step: [B, T] -> [B]."""
+    return series.max(dim=-1).values > threshold
 
 
 def pose_errors(p: torch.Tensor, q: torch.Tensor, p_goal: torch.Tensor, q_goal: torch.Tensor,

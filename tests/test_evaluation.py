@@ -1,0 +1,80 @@
+"""Evaluation protocols: determinism, the scripted baseline, settings, fail-fast checks."""
+import json
+
+import pytest
+import torch
+
+from unicross import evaluation as E
+from unicross.cli import main as cli
+from unicross.objects import get_object_set
+
+
+def test_same_seed_same_results(grasp_file, tiny_objects):
+    def run():
+        return E.run_protocol("translate", E.make_random_policy(0), tiny_objects, trials_per_object=2, seed=4,
+                              grasp_dataset=grasp_file, progress=False)
+    a, b = run(), run()
+    assert json.dumps(a) == json.dumps(b)
+    assert len(a) == 2 * 2 * 2  # 2 elongated objects x 2 directions x 2 trials
+    c = E.run_protocol("translate", E.make_random_policy(0), tiny_objects, trials_per_object=2, seed=5,
+                       grasp_dataset=grasp_file, progress=False)
+    assert json.dumps(a) != json.dumps(c)
+
+
+def test_scripted_relocation_baseline_table(grasp_file, tiny_objects):
+    trials = E.run_protocol("relocate", E.scripted_relocate_policy, tiny_objects, trials_per_object=2,
+                            grasp_dataset=grasp_file, progress=False)
+    s = E.summarize("relocate", trials)
+    assert s["n"] == 8 and s["pe_cm"] == s["pe_cm"]  # finite PE over non-dropped trials
+    # the baseline moves the object towards the goal: far closer than the 0.2-0.4 m start offset
+    assert s["pe_cm"] < 10.0
+    assert "Relocate SR" in E.markdown_table({"baseline": {"relocate": s}})
+
+
+def test_disturbance_and_original_settings(grasp_file, tiny_objects):
+    obj = [o for o in tiny_objects if o.category == "wrappable"][0]
+    env = E._env_for("rotate", "z+", obj, "allegro", disturb=True, randomize=False, grasp_dataset=grasp_file,
+                     original=True)
+    u = env.unwrapped
+    u.reset(seed=0)
+    m, g = u.obj_mass[0].item(), 9.81
+    f = u.disturb[0].norm().item()
+    assert 0 < f <= 10 * m * g + 1e-6
+    from unicross.geometry import quat_apply
+    x_h = quat_apply(u.root_q, torch.tensor([[1.0, 0.0, 0.0]]))
+    assert x_h[0, 2].item() == pytest.approx(1.0, abs=1e-5)  # palm up
+    env.close()
+    env = E._env_for("grasp", None, obj, "allegro", disturb=False, randomize=False, grasp_dataset=None, original=True)
+    assert not hasattr(env.unwrapped, "table")  # no table in GraspXL's setting
+    env.close()
+
+
+def test_fail_fast(tmp_path):
+    with pytest.raises(ValueError, match="valid"):
+        E.run_protocol("juggle", E.zero_policy, get_object_set("train", limit=1), progress=False)
+    assert cli(["eval", "--policy", "zero", "--protocol", "juggle", "--out", str(tmp_path / "x.json")]) == 2
+    assert cli(["eval", "--policy", "zero", "--objects", "nowhere", "--out", str(tmp_path / "x.json")]) == 2
+    assert cli(["eval", "--policy", str(tmp_path / "missing.pt"), "--out", str(tmp_path / "x.json")]) == 2
+    # a checkpoint with the wrong observation size
+    from unicross.rl.models import make_models
+    from unicross.config import load_config
+    policy, _, _ = make_models(dict(hand=10, object=20, goal=55), 5, None, load_config("ppo")["model"])
+    bad = tmp_path / "bad.pt"
+    torch.save(dict(policy=policy.state_dict(), obs_dims=dict(hand=10, object=20, goal=55), n_act=5,
+                    hand="allegro", config=load_config("ppo"), skill="grasp"), bad)
+    with pytest.raises(ValueError, match="expects observation"):
+        E.resolve_policy(str(bad), "allegro")
+    torch.save(dict(policy=policy.state_dict(), obs_dims=dict(hand=10, object=20, goal=55), n_act=5,
+                    hand="mano", config=load_config("ppo"), skill="grasp"), bad)
+    with pytest.raises(ValueError, match="hand"):
+        E.resolve_policy(str(bad), "allegro")
+
+
+def test_cli_eval_and_report(tmp_path, grasp_file):
+    out = tmp_path / "r.json"
+    assert cli(["eval", "--policy", "zero", "--protocol", "grasp", "--objects", "train-wrappable", "--limit", "1",
+                "--trials-per-object", "1", "--out", str(out)]) == 0
+    r = json.loads(out.read_text())
+    assert r["summaries"]["grasp"]["n"] == 2 and len(r["trials"]["grasp"]) == 2
+    assert cli(["report", str(out), "--out", str(tmp_path / "t.md")]) == 0
+    assert "Grasp SR" in (tmp_path / "t.md").read_text()

@@ -1,0 +1,230 @@
+"""The paper's evaluation protocols (§4.2, 4.5) as functions over a policy and an object set.
+
+Each protocol resets a task per (object, trial[, axis]) with a seed derived from ``seed``, rolls
+the policy out for the protocol's number of steps, records the trajectory (object pose in the
+hand frame and in the world, drop flags) and scores it with :mod:`unicross.metrics`:
+
+  grasp      25 table poses per object, 75 steps, the wrist rises after step 50;
+             success = lifted (>= 5 cm) and never dropped
+  relocate   25 grasp states per object, final pose offsets x, y U[-0.1, 0.1] m, z U[0.2, 0.4] m,
+             roll/pitch/yaw U[-0.75, 0.75] rad, 75 steps; PE (cm) / AE (rad) over the last 25 steps
+             of non-dropped trials; success = final errors within 3 cm and 0.15 rad, never dropped
+  rotate     25 grasp states x 6 axes, random world wrist orientation, 400 steps;
+             success = accumulated rotation about the axis exceeded pi/2, never dropped;
+             Rot. = mean accumulated rotation (rad) of non-dropped trials
+  translate  25 grasp states x 2 directions, 50 steps; success = displacement exceeded 5 cm,
+             never dropped; Trans. = mean displacement (cm) of non-dropped trials
+  --disturb  adds a constant force of random direction and magnitude U[0, 10 m g] on the object
+             for the whole episode (grasp: while lifting)
+
+Policies: a checkpoint path, ``zero`` (no action), ``random`` or ``scripted-relocate`` (the
+paper's naive relocation baseline). Same seed and policy give identical results.
+"""
+from __future__ import annotations
+
+from typing import Callable, Dict, List, Optional, Sequence
+
+import gymnasium as gym
+import torch
+from tqdm import tqdm
+
+from unicross import formulation as F
+from unicross import metrics as M
+from unicross.geometry import pose_inv, pose_mul, quat_to_euler_xyz
+from unicross.objects import ObjectSpec
+
+PROTOCOLS = ("grasp", "relocate", "rotate", "translate")
+STEPS = dict(grasp=75, relocate=75, rotate=400, translate=50)
+AXES = dict(grasp=[None], relocate=[None], rotate=list(F.ROTATE_AXES), translate=list(F.TRANSLATE_DIRECTIONS))
+ENV_ID = dict(grasp="UniCross-Grasp-v1", relocate="UniCross-Relocate-v1", rotate="UniCross-Rotate-v1",
+              translate="UniCross-Translate-v1")
+CATEGORY = dict(grasp=None, relocate=None, rotate="wrappable", translate="elongated")
+
+PolicyFn = Callable[[dict, object], torch.Tensor]
+
+
+# ----------------------------------------------------------------------------- policies
+def zero_policy(obs, u) -> torch.Tensor:
+    return torch.zeros(u.num_envs, u.hand_spec.dof, device=u.device)
+
+
+def make_random_policy(seed: int) -> PolicyFn:
+    g = torch.Generator().manual_seed(seed)
+
+    def policy(obs, u):
+        return (torch.rand(u.num_envs, u.hand_spec.dof, generator=g) * 2 - 1).to(u.device)
+    return policy
+
+
+def scripted_relocate_policy(obs, u, tighten: float = 0.1) -> torch.Tensor:
+    """The paper's naive relocation baseline: tighten the fingers of the grasp slightly and drive
+    the wrist (PD, through the action interface) to the pose that realises the final object pose
+    with the object-in-hand pose fixed at its start value."""
+    a = torch.zeros(u.num_envs, u.hand_spec.dof, device=u.device)
+    scale = u.action_scale
+    from unicross.scripted_grasp import closing_delta
+    delta = closing_delta(u.hand_spec).to(u.device) / 0.7 * tighten
+    q_des = torch.clamp(u.finger_q0 + delta, u.q_lower[6:], u.q_upper[6:])
+    a[:, 6:] = (q_des - u.command[:, 6:]) / scale[6:]
+    init = u.init_rel
+    ip, iq = pose_inv(init.x_oh, init.q_oh)
+    hx, hq = pose_mul(u.final_x_or, u.final_q_or, ip, iq)
+    q_wrist = torch.cat([hx, quat_to_euler_xyz(hq)], dim=-1)
+    ref = F.wrist_reference(u.targets)
+    a[:, :6] = (q_wrist - ref) / scale[:6]
+    return a.clamp(-1.0, 1.0)
+
+
+def resolve_policy(spec: str, hand: str, seed: int = 0):
+    """(policy_fn, description). Checkpoints are checked against the hand before any simulation."""
+    if spec == "zero":
+        return zero_policy, dict(kind="zero")
+    if spec == "random":
+        return make_random_policy(seed), dict(kind="random")
+    if spec == "scripted-relocate":
+        return scripted_relocate_policy, dict(kind="scripted-relocate")
+    from unicross.rl.policy_io import act, load_policy
+    from unicross.robots.hand import load_hand
+    policy, ck = load_policy(spec)
+    spec_h = load_hand(hand)
+    if ck["hand"] != hand:
+        raise ValueError(f"checkpoint {spec} was trained for hand {ck['hand']!r}, not {hand!r}")
+    L = len(spec_h.contact_links)
+    expected = dict(hand=2 * spec_h.dof, object=5 * L, goal=F.GOAL_DIM)
+    if dict(ck["obs_dims"]) != expected or ck["n_act"] != spec_h.dof:
+        raise ValueError(f"checkpoint {spec} expects observation {ck['obs_dims']} / action {ck['n_act']}, "
+                         f"hand {hand!r} gives {expected} / {spec_h.dof}")
+    return (lambda obs, u: act(policy, obs)), dict(kind="checkpoint", path=str(spec), skill=ck.get("skill"),
+                                                   axis=ck.get("axis"), git_commit=ck.get("git_commit"))
+
+
+# ----------------------------------------------------------------------------- one protocol
+def _env_for(protocol: str, axis: Optional[str], obj: ObjectSpec, hand: str, disturb: bool, randomize: bool,
+             grasp_dataset, original: bool):
+    cfg = dict(episode_length={protocol: STEPS[protocol]})
+    if disturb:
+        cfg["disturbance"] = dict(max_scale=10.0)
+    if original and protocol == "grasp":
+        cfg["table"] = False  # GraspXL's setting: no table
+    if original and protocol in ("rotate", "translate"):
+        cfg["in_hand_orientation"] = "palm_up"  # RotateIt / in-hand translation: palm up, wrist fixed
+    kw = dict(obs_mode="state_dict", sim_backend="physx_cpu", render_backend="none", hand=hand, objects=[obj],
+              randomize=randomize, config=cfg)
+    if protocol == "rotate":
+        kw["axis"] = axis
+    if protocol == "translate":
+        kw["direction"] = axis
+    if protocol != "grasp" and grasp_dataset is not None:
+        kw["grasp_dataset"] = grasp_dataset
+    return gym.make(ENV_ID[protocol], **kw)
+
+
+def run_protocol(protocol: str, policy: PolicyFn, objects: Sequence[ObjectSpec], hand: str = "allegro",
+                 trials_per_object: int = 25, seed: int = 0, disturb: bool = False, randomize: bool = False,
+                 grasp_dataset=None, original: bool = False, progress: bool = True,
+                 record: Optional[Callable] = None) -> List[dict]:
+    """All trials of one protocol; returns one dict per trial."""
+    if protocol not in PROTOCOLS:
+        raise ValueError(f"unknown protocol {protocol!r}; valid: {list(PROTOCOLS)}")
+    cat = CATEGORY[protocol]
+    objs = [o for o in objects if cat is None or o.category == cat]
+    if not objs:
+        raise ValueError(f"no {cat} object in the set for protocol {protocol!r}")
+    steps = STEPS[protocol]
+    trials = []
+    total = len(objs) * len(AXES[protocol]) * trials_per_object
+    bar = tqdm(total=total, desc=f"eval {protocol}", disable=not progress)
+    for oi, obj in enumerate(objs):
+        for axis in AXES[protocol]:
+            env = _env_for(protocol, axis, obj, hand, disturb, randomize, grasp_dataset, original)
+            u = env.unwrapped
+            axis_vec = F.MODE_AXES[F.mode_index(protocol, axis) if protocol in ("rotate", "translate") else 0]
+            for k in range(trials_per_object):
+                trial_seed = seed * 1_000_003 + oi * 10_007 + (AXES[protocol].index(axis)) * 1009 + k
+                obs, info = u.reset(seed=trial_seed)
+                x_oh, q_oh, p_w, q_w, drop = [u.cur_rel.x_oh.clone()], [u.cur_rel.q_oh.clone()], [], [], []
+                goal_p, goal_q = pose_mul(u.root_p, u.root_q, u.final_x_or, u.final_q_or)
+                for t in range(steps):
+                    a = policy(obs, u)
+                    if original and protocol in ("rotate", "translate"):
+                        a[:, :6] = 0.0  # fixed wrist
+                    obs, _, term, _, info = u.step(a)
+                    x_oh.append(u.cur_rel.x_oh.clone())
+                    q_oh.append(u.cur_rel.q_oh.clone())
+                    pos, quat = u.sensor.poses()
+                    p_w.append(pos[:, -1].clone())
+                    q_w.append(quat[:, -1].clone())
+                    drop.append(info["drop"].clone())
+                    if record is not None:
+                        record(u, info, t)
+                    if bool(term.all()):
+                        break
+                trials.append(_score(protocol, obj, axis, k, trial_seed, axis_vec.to(u.device),
+                                     torch.stack(x_oh, 1), torch.stack(q_oh, 1), torch.stack(p_w, 1),
+                                     torch.stack(q_w, 1), torch.stack(drop, 1), goal_p, goal_q, info, u))
+                bar.update(1)
+            env.close()
+    bar.close()
+    return trials
+
+
+def _score(protocol, obj, axis, k, seed, axis_vec, x_oh, q_oh, p_w, q_w, drop, goal_p, goal_q, info, u) -> dict:
+    dropped = bool(M.ever(drop)[0])
+    row = dict(object=obj.name, category=obj.category, shape=obj.shape, axis=axis, trial=k, seed=seed,
+               steps=int(drop.shape[1]), dropped=dropped)
+    if protocol == "grasp":
+        lifted = bool(((p_w[:, -1, 2] - u.obj_z0) > u.cfg["grasp"]["lift_success"])[0])
+        row.update(lifted=lifted, success=lifted and not dropped)
+    elif protocol == "relocate":
+        pe, ae = M.pose_errors(p_w, q_w, goal_p, goal_q, window=25)
+        pe_end, ae_end = M.pose_errors(p_w, q_w, goal_p, goal_q, window=1)
+        sc = u.cfg["success"]
+        ok = bool(pe_end[0] < sc["relocate_pos"]) and bool(ae_end[0] < sc["relocate_rot"])
+        row.update(pe_cm=100 * float(pe[0]), ae_rad=float(ae[0]), success=ok and not dropped)
+    elif protocol == "rotate":
+        series = M.rotation_series(q_oh, axis_vec)
+        row.update(rotation_rad=float(series[0, -1]),
+                   success=bool(M.exceeded(series, u.cfg["success"]["rotate_angle"])[0]) and not dropped)
+    else:
+        series = M.translation_series(x_oh, axis_vec)
+        row.update(translation_cm=100 * float(series[0, -1]),
+                   success=bool(M.exceeded(series, u.cfg["success"]["translate_dist"])[0]) and not dropped)
+    return row
+
+
+# ----------------------------------------------------------------------------- summaries and tables
+def summarize(protocol: str, trials: List[dict]) -> dict:
+    succ = torch.tensor([t["success"] for t in trials], dtype=torch.bool)
+    kept = torch.tensor([not t["dropped"] for t in trials], dtype=torch.bool)
+    out = dict(M.success_summary(succ), non_dropped=int(kept.sum()))
+    if protocol == "relocate":
+        out["pe_cm"] = M.mean_over(torch.tensor([t["pe_cm"] for t in trials]), kept)
+        out["ae_rad"] = M.mean_over(torch.tensor([t["ae_rad"] for t in trials]), kept)
+    if protocol == "rotate":
+        out["rot_rad"] = M.mean_over(torch.tensor([t["rotation_rad"] for t in trials]), kept)
+    if protocol == "translate":
+        out["trans_cm"] = M.mean_over(torch.tensor([t["translation_cm"] for t in trials]), kept)
+    return out
+
+
+COLUMNS = ["Grasp SR", "Relocate SR", "PE", "AE", "Rotate SR", "Rot.", "Translate SR", "Trans."]
+
+
+def table_row(summaries: Dict[str, dict]) -> List[str]:
+    def sr(p):
+        s = summaries.get(p)
+        return "--" if s is None else f"{s['sr']:.1f} [{s['ci95'][0]:.0f}-{s['ci95'][1]:.0f}] (n={s['n']})"
+
+    def val(p, k, fmt):
+        s = summaries.get(p)
+        return "--" if s is None or s.get(k) is None or s[k] != s[k] else fmt.format(s[k])
+    return [sr("grasp"), sr("relocate"), val("relocate", "pe_cm", "{:.2f}"), val("relocate", "ae_rad", "{:.4f}"),
+            sr("rotate"), val("rotate", "rot_rad", "{:.2f}"), sr("translate"), val("translate", "trans_cm", "{:.1f}")]
+
+
+def markdown_table(rows: Dict[str, Dict[str, dict]]) -> str:
+    """rows: label -> {protocol: summary}. Paper layout; SR cells carry the 95% Wilson interval and n."""
+    lines = ["| Setting | " + " | ".join(COLUMNS) + " |", "|---|" + "---|" * len(COLUMNS)]
+    for label, summ in rows.items():
+        lines.append(f"| {label} | " + " | ".join(table_row(summ)) + " |")
+    return "\n".join(lines)
