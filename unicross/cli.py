@@ -6,6 +6,7 @@
     unicross train --skill SKILL ...      train one expert with PPO (resumable)
     unicross eval --policy P ...          the paper's evaluation protocols -> JSON + table
     unicross report FILES...              assemble eval results into the paper's tables
+    unicross render TRAJ --out V.mp4      draw a trajectory file (no GPU needed)
 
 Bad input (unknown skill/axis/hand/object set, missing files) fails before any simulation.
 """
@@ -195,6 +196,15 @@ def _cmd_report(args) -> int:
     return 0
 
 
+def _cmd_render(args) -> int:
+    from unicross.render import render
+    w, h = (int(v) for v in args.size.lower().split("x"))
+    out = render(args.trajectory, args.out, camera=args.camera, width=w, height=h, fps=args.fps,
+                 renderer=args.renderer, every=args.every)
+    print(f"wrote {out}")
+    return 0
+
+
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(prog="unicross", description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = p.add_subparsers(dest="cmd", required=True)
@@ -245,6 +255,15 @@ def main(argv=None) -> int:
     s.add_argument("--title", default=None)
     s.add_argument("--out", default=None)
     s.set_defaults(fn=_cmd_report)
+    s = sub.add_parser("render", help="render a trajectory file to .mp4/.gif/.png (CPU: pyrender+EGL; GPU: SAPIEN)")
+    s.add_argument("trajectory")
+    s.add_argument("--out", required=True, help="video.mp4, anim.gif or still.png (last frame)")
+    s.add_argument("--camera", default="front", help="front | side | top | follow")
+    s.add_argument("--size", default="640x480")
+    s.add_argument("--fps", type=int, default=None)
+    s.add_argument("--every", type=int, default=1, help="render every k-th step")
+    s.add_argument("--renderer", default="auto", help="auto | pyrender | sapien")
+    s.set_defaults(fn=_cmd_render)
     s = sub.add_parser("train", help="train one expert with PPO (TorchRL); resumable")
     s.add_argument("--skill", choices=["grasp", "relocate", "rotate", "translate"], default=None)
     s.add_argument("--axis", default=None, help="rotate: x+,x-,y+,y-,z+,z-; translate: z+,z-")
@@ -261,7 +280,7 @@ def main(argv=None) -> int:
     args = p.parse_args(argv)
     try:
         return args.fn(args)
-    except (ValueError, FileNotFoundError, FileExistsError, KeyError, RuntimeError) as e:
+    except (ValueError, FileNotFoundError, FileExistsError, KeyError, RuntimeError) as e:  # incl. RenderUnavailable
         print(f"unicross {args.cmd}: error: {e}", file=sys.stderr)
         return 2
 
