@@ -165,7 +165,8 @@ def _cmd_eval(args) -> int:
     for p in protocols:
         trials = E.run_protocol(p, policy, objs, hand=args.hand, trials_per_object=args.trials_per_object,
                                 seed=args.seed, disturb=args.disturb, randomize=args.randomize,
-                                grasp_dataset=args.grasps, original=args.original)
+                                grasp_dataset=args.grasps, original=args.original, videos=args.videos,
+                                video_dir=Path(args.out).parent / (Path(args.out).stem + "_videos"))
         result["trials"][p] = trials
         result["summaries"][p] = E.summarize(p, trials)
     out = Path(args.out)
@@ -248,6 +249,7 @@ def main(argv=None) -> int:
     s.add_argument("--hand", default="allegro")
     s.add_argument("--seed", type=int, default=0)
     s.add_argument("--label", default=None, help="row label in tables (default: the policy name)")
+    s.add_argument("--videos", type=int, default=0, help="record and render the first K trials of each protocol")
     s.add_argument("--out", required=True)
     s.set_defaults(fn=_cmd_eval)
     s = sub.add_parser("report", help="assemble eval JSON files into the paper's table layout")

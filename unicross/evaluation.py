@@ -122,8 +122,9 @@ def _env_for(protocol: str, axis: Optional[str], obj: ObjectSpec, hand: str, dis
 def run_protocol(protocol: str, policy: PolicyFn, objects: Sequence[ObjectSpec], hand: str = "allegro",
                  trials_per_object: int = 25, seed: int = 0, disturb: bool = False, randomize: bool = False,
                  grasp_dataset=None, original: bool = False, progress: bool = True,
-                 record: Optional[Callable] = None) -> List[dict]:
-    """All trials of one protocol; returns one dict per trial."""
+                 videos: int = 0, video_dir=None) -> List[dict]:
+    """All trials of one protocol; returns one dict per trial. The first ``videos`` trials are
+    recorded as trajectory files (and rendered to mp4) in ``video_dir``."""
     if protocol not in PROTOCOLS:
         raise ValueError(f"unknown protocol {protocol!r}; valid: {list(PROTOCOLS)}")
     cat = CATEGORY[protocol]
@@ -142,6 +143,11 @@ def run_protocol(protocol: str, policy: PolicyFn, objects: Sequence[ObjectSpec],
             for k in range(trials_per_object):
                 trial_seed = seed * 1_000_003 + oi * 10_007 + (AXES[protocol].index(axis)) * 1009 + k
                 obs, info = u.reset(seed=trial_seed)
+                rec = None
+                if len(trials) < videos:
+                    from unicross.trajectory import TrajectoryRecorder
+                    rec = TrajectoryRecorder(u, task_id=ENV_ID[protocol])
+                    rec.record(protocol)
                 x_oh, q_oh, p_w, q_w, drop = [u.cur_rel.x_oh.clone()], [u.cur_rel.q_oh.clone()], [], [], []
                 goal_p, goal_q = pose_mul(u.root_p, u.root_q, u.final_x_or, u.final_q_or)
                 for t in range(steps):
@@ -155,10 +161,12 @@ def run_protocol(protocol: str, policy: PolicyFn, objects: Sequence[ObjectSpec],
                     p_w.append(pos[:, -1].clone())
                     q_w.append(quat[:, -1].clone())
                     drop.append(info["drop"].clone())
-                    if record is not None:
-                        record(u, info, t)
+                    if rec is not None:
+                        rec.record(protocol)
                     if bool(term.all()):
                         break
+                if rec is not None:
+                    _save_video(rec, video_dir, f"{protocol}_{obj.name}_{axis or 'na'}_{k}")
                 trials.append(_score(protocol, obj, axis, k, trial_seed, axis_vec.to(u.device),
                                      torch.stack(x_oh, 1), torch.stack(q_oh, 1), torch.stack(p_w, 1),
                                      torch.stack(q_w, 1), torch.stack(drop, 1), goal_p, goal_q, info, u))
@@ -166,6 +174,17 @@ def run_protocol(protocol: str, policy: PolicyFn, objects: Sequence[ObjectSpec],
             env.close()
     bar.close()
     return trials
+
+
+def _save_video(rec, video_dir, name: str) -> None:
+    from pathlib import Path
+    from unicross.render import RenderUnavailable, render
+    d = Path(video_dir or ".")
+    traj = rec.save(d / f"{name}.npz")
+    try:
+        render(traj, d / f"{name}.mp4", progress=False)
+    except RenderUnavailable as e:  # keep the trajectory; say once why there is no video
+        print(f"video skipped ({e}); render later with `unicross render {traj} --out {name}.mp4`")
 
 
 def _score(protocol, obj, axis, k, seed, axis_vec, x_oh, q_oh, p_w, q_w, drop, goal_p, goal_q, info, u) -> dict:
