@@ -100,8 +100,11 @@ class UniCrossEnv(BaseEnv):
         objs = [o.scaled(self.hand_spec.object_scale) for o in objs]
         self.object_specs = objs
         # valid (object, mode) pairs: rotate needs wrappable, translate elongated objects
-        self._pairs = [(oi, F.MODES.index(m)) for oi, o in enumerate(objs) for m in modes
-                       if o.category in MODE_CATEGORIES[F.mode_skill(m)]]
+        # valid (object, mode) pairs, interleaved round-robin over modes so that consecutive pairs
+        # (parallel envs, successive rebuilds) spread over all modes
+        per_mode = [[(oi, F.MODES.index(m)) for oi, o in enumerate(objs) if o.category in MODE_CATEGORIES[F.mode_skill(m)]]
+                    for m in modes]
+        self._pairs = [lst[r] for r in range(max(map(len, per_mode), default=0)) for lst in per_mode if r < len(lst)]
         if not self._pairs:
             raise ValueError(f"no object of the given set fits modes {list(modes)} "
                              f"(rotate needs wrappable objects, translate elongated ones)")
@@ -162,8 +165,12 @@ class UniCrossEnv(BaseEnv):
             b.initial_pose = sapien.Pose(p=[0, 0, -0.025])
             self.table = b.build_static(name="table")
         rng = self._batched_episode_rng[0]
-        start = int(rng.randint(len(self._pairs)))
-        pairs = [self._pairs[(start + i) % len(self._pairs)] for i in range(self.num_envs)]
+        # envs take consecutive pairs from a cursor that starts at a seeded random place and moves
+        # on at every rebuild, so parallel envs and reconfigurations cover the pairs uniformly
+        if not hasattr(self, "_pair_cursor"):
+            self._pair_cursor = int(rng.randint(len(self._pairs)))
+        pairs = [self._pairs[(self._pair_cursor + i) % len(self._pairs)] for i in range(self.num_envs)]
+        self._pair_cursor += self.num_envs
         rcfg = self.cfg["randomization"]
         dr = rcfg["enabled"]
         masses = rng.uniform(*rcfg["mass"], size=self.num_envs) if dr else np.full(self.num_envs, 0.02)

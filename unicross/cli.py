@@ -4,6 +4,7 @@
     unicross grasps --objects SET ...     synthesise a grasp-state dataset (scripted) and hold-test it
     unicross rollout --task ID ...        run random or zero actions and print per-term rewards
     unicross train --skill SKILL ...      train one expert with PPO (resumable)
+    unicross distill --experts DIR ...    DAgger distillation of the ten experts into one student
     unicross eval --policy P ...          the paper's evaluation protocols -> JSON + table
     unicross report FILES...              assemble eval results into the paper's tables
     unicross render TRAJ --out V.mp4      draw a trajectory file (no GPU needed)
@@ -206,6 +207,25 @@ def _cmd_render(args) -> int:
     return 0
 
 
+def _cmd_distill(args) -> int:
+    from unicross.rl.dagger import DAggerTrainer
+    overrides = parse_sets(args.set)
+    if args.num_envs is not None:
+        overrides.setdefault("env", {})["num_envs"] = args.num_envs
+    if args.backend is not None:
+        overrides.setdefault("env", {})["backend"] = args.backend
+    if args.epochs is not None:
+        overrides.setdefault("optim", {})["epochs"] = args.epochs
+    trainer = DAggerTrainer(args.out, args.experts, overrides=overrides or None, resume=args.resume)
+    try:
+        last = trainer.train()
+    finally:
+        trainer.close()
+    print(", ".join(f"{k}={v:.4g}" if isinstance(v, float) else f"{k}={v}" for k, v in last.items()))
+    print(f"student checkpoint: {trainer.run_dir / 'checkpoint.pt'} (epoch {trainer.epoch})")
+    return 0
+
+
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(prog="unicross", description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = p.add_subparsers(dest="cmd", required=True)
@@ -266,6 +286,15 @@ def main(argv=None) -> int:
     s.add_argument("--every", type=int, default=1, help="render every k-th step")
     s.add_argument("--renderer", default="auto", help="auto | pyrender | sapien")
     s.set_defaults(fn=_cmd_render)
+    s = sub.add_parser("distill", help="DAgger: distil the ten experts into one student; resumable")
+    s.add_argument("--experts", default=None, help="directory with <mode>/checkpoint.pt for all ten modes")
+    s.add_argument("--out", required=True, help="run directory (student checkpoint.pt, metrics.jsonl, replay/)")
+    s.add_argument("--num-envs", type=int, default=None)
+    s.add_argument("--backend", choices=["physx_cpu", "physx_cuda"], default=None)
+    s.add_argument("--epochs", type=int, default=None)
+    s.add_argument("--set", action="append", metavar="SECTION.KEY=VALUE", help="override configs/dagger.yaml")
+    s.add_argument("--resume", action="store_true")
+    s.set_defaults(fn=_cmd_distill)
     s = sub.add_parser("train", help="train one expert with PPO (TorchRL); resumable")
     s.add_argument("--skill", choices=["grasp", "relocate", "rotate", "translate"], default=None)
     s.add_argument("--axis", default=None, help="rotate: x+,x-,y+,y-,z+,z-; translate: z+,z-")

@@ -13,12 +13,13 @@ if not CONFIG_DIR.exists():  # installed (non-editable): configs ship as unicros
 
 
 def deep_merge(base: dict, override: Optional[Mapping[str, Any]], path: str = "") -> dict:
-    """Return ``base`` updated by ``override``; unknown keys are an error (typos fail loudly)."""
+    """Return ``base`` updated by ``override``; unknown keys are an error (typos fail loudly),
+    except below an empty mapping in ``base``, which is free-form (e.g. ``task_config: {}``)."""
     out = copy.deepcopy(base)
     for k, v in (override or {}).items():
         if k not in out:
             raise KeyError(f"unknown config key {path + k!r}; valid: {sorted(out)}")
-        if isinstance(out[k], dict) and isinstance(v, Mapping):
+        if isinstance(out[k], dict) and out[k] and isinstance(v, Mapping):
             out[k] = deep_merge(out[k], v, path + k + ".")
         else:
             out[k] = copy.deepcopy(v)

@@ -1,0 +1,249 @@
+"""DAgger distillation of the ten per-mode experts into one student (paper §3.3).
+
+Each epoch the student acts in ``UniCross-MultiSkill-v1`` (environments spread over valid
+(object, mode) pairs) for ``rollout_steps``; every visited state is labelled by the frozen expert
+of its mode (query rate 100%); the (observation, expert action) pairs go to a TensorDict replay
+buffer (``LazyTensorStorage``, capacity 1e6 by default); the student then takes
+``grad_steps`` MSE steps on sampled batches.
+
+The trainer refuses to start unless every mode has an expert checkpoint
+(``<experts>/<mode>/checkpoint.pt``, the run directories of ``unicross train``).
+Checkpoints (student, optimiser, epoch, replay buffer, RNG) make runs resumable; per-mode action
+MSE and per-mode success rates are logged.
+"""
+from __future__ import annotations
+
+import json
+import random
+import time
+from pathlib import Path
+from typing import Dict, Optional
+
+import numpy as np
+import torch
+from tensordict import TensorDict
+from torchrl.collectors import Collector
+from torchrl.data import LazyTensorStorage, TensorDictReplayBuffer
+from torchrl.envs.utils import ExplorationType, set_exploration_type
+from tqdm import tqdm
+
+from unicross import formulation as F
+from unicross.config import deep_merge, load_config
+from unicross.rl.env import make_env
+from unicross.rl.models import OBS_KEYS, make_models, obs_dims_from_spec
+from unicross.rl.policy_io import load_policy
+from unicross.rl.ppo import atomic_save, git_commit
+
+CKPT_NAME = "checkpoint.pt"
+
+
+def expert_paths(experts_dir, modes=F.MODES) -> Dict[str, Path]:
+    d = Path(experts_dir)
+    paths = {m: d / m / "checkpoint.pt" for m in modes}
+    missing = [m for m, p in paths.items() if not p.exists()]
+    if missing:
+        raise FileNotFoundError(f"no expert checkpoint for mode(s) {missing} under {d} "
+                                f"(expected <experts>/<mode>/checkpoint.pt, e.g. from "
+                                f"`unicross train --skill rotate --axis x+ --out {d}/rotate_x+`)")
+    return paths
+
+
+class Teachers(torch.nn.Module):
+    """The frozen experts; labels a batch by each state's mode (read from g's one-hot)."""
+
+    def __init__(self, paths: Dict[str, Path], device):
+        super().__init__()
+        self.experts = torch.nn.ModuleDict()
+        self.hand = None
+        for m, p in paths.items():
+            pol, ck = load_policy(p, device)
+            self.n_act = ck["n_act"]
+            if self.hand is None:
+                self.hand = ck["hand"]
+            elif ck["hand"] != self.hand:
+                raise ValueError(f"expert {p} is for hand {ck['hand']!r}, the others for {self.hand!r}")
+            for prm in pol.parameters():
+                prm.requires_grad_(False)
+            self.experts[m.replace("+", "p").replace("-", "m")] = pol.eval()
+        self.modes = list(paths)
+
+    @torch.no_grad()
+    def forward(self, td: TensorDict) -> torch.Tensor:
+        mode = td["goal"][..., :F.NUM_MODES].argmax(-1)
+        out = torch.zeros(td.batch_size + (self.n_act,), device=td.device)
+        with set_exploration_type(ExplorationType.DETERMINISTIC):
+            for m in self.modes:
+                mask = mode == F.MODES.index(m)
+                if bool(mask.any()):
+                    sub = td[mask].select(*OBS_KEYS)
+                    out[mask] = self.experts[m.replace("+", "p").replace("-", "m")](sub)["action"]
+        return out.clamp(-1.0, 1.0)
+
+
+class DAggerTrainer:
+    def __init__(self, run_dir, experts_dir=None, overrides: Optional[dict] = None, resume: bool = False,
+                 progress: bool = True):
+        self.run_dir = Path(run_dir)
+        ck_path = self.run_dir / CKPT_NAME
+        self.ckpt = None
+        if resume:
+            if not ck_path.exists():
+                raise FileNotFoundError(f"cannot resume: no checkpoint at {ck_path}")
+            self.ckpt = torch.load(ck_path, map_location="cpu", weights_only=False)
+            cfg = deep_merge(self.ckpt["config"], overrides)
+            experts_dir = experts_dir or self.ckpt["experts_dir"]
+        else:
+            if ck_path.exists():
+                raise FileExistsError(f"{ck_path} exists: pass --resume to continue it or choose another --out")
+            if experts_dir is None:
+                raise ValueError("--experts is required")
+            cfg = load_config("dagger", overrides)
+        self.cfg, self.experts_dir, self.progress = cfg, str(experts_dir), progress
+        modes = cfg["env"]["modes"] or list(F.MODES)
+        paths = expert_paths(experts_dir, modes)  # refuses to start without every expert
+        self._seed(cfg["seed"])
+        ec = cfg["env"]
+        kw = dict(randomize=ec["randomize"], reconfiguration_freq=ec["reconfiguration_freq"], modes=modes,
+                  config=ec["task_config"] or None)
+        if ec.get("objects"):
+            kw["objects"] = ec["objects"]
+        if ec.get("object_limit") is not None:
+            kw["object_limit"] = ec["object_limit"]
+        self.device = torch.device("cuda" if ec["backend"] == "physx_cuda" else "cpu")
+        self.teachers = Teachers(paths, self.device)
+        kw["hand"] = self.teachers.hand
+        self.env_kwargs = kw
+        self.env = make_env("UniCross-MultiSkill-v1", kw, ec["num_envs"], ec["backend"])
+        self.env.set_seed(cfg["seed"])
+        self.dims = obs_dims_from_spec(self.env.observation_spec)
+        self.n_act = self.env.action_spec.shape[-1]
+        self.student, _, self.norm = make_models(self.dims, self.n_act, self.env.action_spec, cfg["model"])
+        self.student.to(self.device)
+        self.actor = self.student.module[0]  # hand/object/goal -> loc, scale
+        self.optim = torch.optim.Adam(self.actor.parameters(), lr=cfg["optim"]["lr"])
+        self.rb = TensorDictReplayBuffer(storage=LazyTensorStorage(cfg["buffer"]["capacity"], device=self.device),
+                                         batch_size=cfg["optim"]["batch_size"])
+        self.epoch, self.frames = 0, 0
+        if self.ckpt is not None:
+            self._load(self.ckpt)
+        n_envs = int(np.prod(self.env.batch_size)) if len(self.env.batch_size) else 1
+        self.collector = Collector(self.env, self.student, frames_per_batch=n_envs * cfg["collector"]["rollout_steps"],
+                                   total_frames=-1, device=self.device, exploration_type=ExplorationType.DETERMINISTIC,
+                                   auto_register_policy_transforms=False)
+        self._batches = iter(self.collector)
+
+    # ------------------------------------------------------------------ state
+    def _seed(self, seed):
+        torch.manual_seed(seed)
+        np.random.seed(seed)
+        random.seed(seed)
+
+    def state(self) -> dict:
+        return dict(policy=self.student.state_dict(), optim=self.optim.state_dict(), epoch=self.epoch,
+                    frames=self.frames, config=self.cfg, experts_dir=self.experts_dir, skill="multi", axis=None,
+                    hand=self.teachers.hand, obs_dims=self.dims, n_act=self.n_act, git_commit=git_commit(),
+                    env_kwargs=self.env_kwargs,
+                    rng=dict(torch=torch.get_rng_state(), numpy=np.random.get_state(), python=random.getstate()))
+
+    def save(self):
+        self.run_dir.mkdir(parents=True, exist_ok=True)
+        if len(self.rb):
+            self.rb.dumps(self.run_dir / "replay")
+        atomic_save(self.state(), self.run_dir / CKPT_NAME)
+
+    def _load(self, ck):
+        self.student.load_state_dict(ck["policy"])
+        self.optim.load_state_dict(ck["optim"])
+        self.epoch, self.frames = ck["epoch"], ck["frames"]
+        torch.set_rng_state(ck["rng"]["torch"])
+        np.random.set_state(ck["rng"]["numpy"])
+        random.setstate(ck["rng"]["python"])
+        if (self.run_dir / "replay").exists():
+            self.rb.loads(self.run_dir / "replay")
+
+    # ------------------------------------------------------------------ one epoch
+    @torch.no_grad()
+    def collect(self) -> dict:
+        """Roll the student out for ``rollout_steps`` (deterministic actions); label every visited
+        state by its mode's expert; store (observation, expert action, mode)."""
+        flat = next(self._batches).reshape(-1)
+        labels = self.teachers(flat)
+        item = flat.select(*OBS_KEYS).clone()
+        item["expert_action"] = labels
+        item["mode"] = flat["goal"][..., :F.NUM_MODES].argmax(-1)
+        self.rb.extend(item)
+        self.norm.update({k: item[k] for k in OBS_KEYS})
+        self.frames += flat.numel()
+        done = flat["next", "done"].squeeze(-1)
+        succ = flat["next", "info", "success"].squeeze(-1)
+        stats = {}
+        for i, m in enumerate(F.MODES):
+            sel = done & (item["mode"] == i)
+            if bool(sel.any()):
+                stats[f"success/{m}"] = float(succ[sel].float().mean())
+        return stats
+
+    def update(self) -> dict:
+        """``grad_steps`` MSE steps on replay batches; returns the mean loss and per-mode MSE."""
+        oc = self.cfg["optim"]
+        total, per_mode, counts = 0.0, torch.zeros(F.NUM_MODES), torch.zeros(F.NUM_MODES)
+        for _ in range(oc["grad_steps"]):
+            b = self.rb.sample()
+            pred = self.actor(b.select(*OBS_KEYS).clone())["loc"]
+            err = ((pred - b["expert_action"]) ** 2).mean(-1)
+            loss = err.mean()
+            self.optim.zero_grad(set_to_none=True)
+            loss.backward()
+            self.optim.step()
+            total += float(loss.detach())
+            with torch.no_grad():
+                per_mode.index_add_(0, b["mode"].cpu(), err.detach().cpu())
+                counts.index_add_(0, b["mode"].cpu(), torch.ones_like(err).cpu())
+        out = {"mse": total / oc["grad_steps"]}
+        for i, m in enumerate(F.MODES):
+            if counts[i] > 0:
+                out[f"mse/{m}"] = float(per_mode[i] / counts[i])
+        return out
+
+    @torch.no_grad()
+    def action_mse(self, td: TensorDict) -> Dict[str, float]:
+        """Per-mode MSE between the student's mean action and the experts' labels on ``td``."""
+        labels = self.teachers(td)
+        pred = self.actor(td.select(*OBS_KEYS).clone())["loc"]
+        err = ((pred - labels) ** 2).mean(-1)
+        mode = td["goal"][..., :F.NUM_MODES].argmax(-1)
+        return {m: float(err[mode == i].mean()) for i, m in enumerate(F.MODES) if bool((mode == i).any())}
+
+    def train(self, epochs: Optional[int] = None) -> dict:
+        target = self.cfg["optim"]["epochs"] if epochs is None else self.epoch + epochs
+        self.run_dir.mkdir(parents=True, exist_ok=True)
+        bar = tqdm(total=target, initial=self.epoch, desc="dagger", unit="epoch", disable=not self.progress)
+        last = {}
+        try:
+            while self.epoch < target:
+                t0 = time.perf_counter()
+                col = self.collect()
+                upd = self.update()
+                self.epoch += 1
+                last = dict(epoch=self.epoch, frames=self.frames, buffer=len(self.rb),
+                            seconds=time.perf_counter() - t0, **upd, **col)
+                with open(self.run_dir / "metrics.jsonl", "a") as f:
+                    f.write(json.dumps(last) + "\n")
+                if self.epoch % self.cfg["logging"]["checkpoint_every"] == 0:
+                    self.save()
+                bar.update(1)
+                bar.set_postfix(mse=f"{upd['mse']:.4f}")
+        finally:
+            self.save()
+            bar.close()
+        return last
+
+    def close(self):
+        try:
+            self.collector.shutdown()
+        except Exception:
+            pass
+        try:
+            self.env.close()
+        except Exception:
+            pass
