@@ -406,9 +406,8 @@ class UniCrossEnv(BaseEnv):
         if not torch.isfinite(a).all():
             raise ValueError("action contains NaN or inf")
         a = a.clamp(-1.0, 1.0)
-        self._advance_lift()
         ref = F.wrist_reference(self.targets)
-        ref[:, :3] = ref[:, :3] + self.lift
+        ref[:, :3] = ref[:, :3] + self._advance_lift()
         self.command = F.map_action(a, self.command, ref, self.action_scale, self.q_lower, self.q_upper,
                                     wrist_from_target=not self.cfg["ablation"]["no_target_action"])
         self._pending = torch.ones_like(self._pending)  # evaluate() advances targets once per step
@@ -419,13 +418,18 @@ class UniCrossEnv(BaseEnv):
         truncated = self.elapsed_steps >= self.episode_length[self.mode]
         return obs, reward, terminated, truncated, info
 
-    def _advance_lift(self):
+    def _advance_lift(self) -> torch.Tensor:
+        """Grasp lift phase: the wrist reference (the Free current wrist pose) rises by
+        ``lift_speed * dt`` per step after ``lift_after`` steps; ``self.lift`` accumulates the rise,
+        which the Fixed object target follows. Returns this step's increment (root frame)."""
         lift_after = self.cfg["grasp"]["lift_after"]
         if lift_after is None or self.static_skill not in (None, "grasp"):
-            return
+            return torch.zeros_like(self.lift)
         lifting = (self.mode == 0) & (self.elapsed_steps >= lift_after)
         up_root = quat_apply(quat_inv(self.root_q), self._world_up.expand_as(self.lift))
-        self.lift = self.lift + lifting[:, None].float() * up_root * self.cfg["grasp"]["lift_speed"] * self.control_dt
+        step = lifting[:, None].float() * up_root * self.cfg["grasp"]["lift_speed"] * self.control_dt
+        self.lift = self.lift + step
+        return step
 
     def _before_control_step(self):
         """This control step's external object forces for all substeps at once: the decaying random

@@ -299,3 +299,17 @@ def test_reward_terms_use_config_coefficients(grasp_file):
     *_, info = env.step(torch.zeros(22))
     assert info["reward_contact"].item() < 0  # hovering: -w_dis * distance dominates
     env.close()
+
+
+def test_grasp_lift_phase_raises_the_wrist_at_the_set_speed():
+    env = make("UniCross-Grasp-v1", randomize=False, config=dict(grasp=dict(lift_after=2, lift_speed=0.2)))
+    u = env.unwrapped
+    env.reset(seed=0)
+    z = []
+    for _ in range(12):
+        env.step(torch.zeros(22))
+        z.append((u.root_p + quat_apply(u.root_q, u.cur_rel.x_hr))[0, 2].item())
+    rise = z[-1] - z[1]
+    # 10 lifting steps at 0.2 m/s * 0.05 s: ~0.1 m (the position-controlled wrist lags a little)
+    assert 0.05 < rise < 0.11
+    env.close()

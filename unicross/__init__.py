@@ -5,7 +5,8 @@ with gymnasium/ManiSkill.
 """
 __version__ = "0.1.0"
 
-from unicross.tasks import skills as _skills  # noqa: F401  (registers the environments)
+from unicross.tasks import chain as _chain  # noqa: F401  (registers the environments)
+from unicross.tasks import skills as _skills  # noqa: F401
 
 TASK_IDS = ("UniCross-Grasp-v1", "UniCross-Relocate-v1", "UniCross-Rotate-v1", "UniCross-Translate-v1",
-            "UniCross-MultiSkill-v1")
+            "UniCross-MultiSkill-v1", "UniCross-Chain-v1")
