@@ -16,7 +16,7 @@ from __future__ import annotations
 from typing import List, Sequence
 
 import torch
-from mani_skill.utils.registration import register_env
+from unicross.tasks.registration import register_task
 from mani_skill.utils.structs.pose import Pose
 
 from unicross import formulation as F
@@ -43,7 +43,7 @@ def parse_sequence(seq: str | Sequence[str]) -> List[str]:
     return modes
 
 
-@register_env("UniCross-Chain-v1", max_episode_steps=sum(PHASE_STEPS.values()))
+@register_task("UniCross-Chain-v1", max_episode_steps=sum(PHASE_STEPS.values()))
 class ChainEnv(UniCrossEnv):
     """Grasp, then the following phases in one continuous episode with one policy."""
 

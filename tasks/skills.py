@@ -1,7 +1,7 @@
 """The UniCross task ids. Skills differ only by data: their modes and default object sets."""
 from __future__ import annotations
 
-from mani_skill.utils.registration import register_env
+from unicross.tasks.registration import register_task
 
 from unicross import formulation as F
 from unicross.tasks.base import UniCrossEnv
@@ -9,7 +9,7 @@ from unicross.tasks.base import UniCrossEnv
 EPISODE_STEPS = dict(grasp=64, relocate=64, rotate=400, translate=64)  # configs/task.yaml episode_length
 
 
-@register_env("UniCross-Grasp-v1", max_episode_steps=EPISODE_STEPS["grasp"])
+@register_task("UniCross-Grasp-v1", max_episode_steps=EPISODE_STEPS["grasp"])
 class GraspEnv(UniCrossEnv):
     """Grasp an object resting on the table from a top-down start (see :class:`UniCrossEnv`)."""
 
@@ -20,14 +20,14 @@ class GraspEnv(UniCrossEnv):
         super().__init__(*args, modes=self.DEFAULT_MODES, **kwargs)
 
 
-@register_env("UniCross-Relocate-v1", max_episode_steps=EPISODE_STEPS["relocate"])
+@register_task("UniCross-Relocate-v1", max_episode_steps=EPISODE_STEPS["relocate"])
 class RelocateEnv(GraspEnv):
     """Move a grasped object to a final pose with the object fixed in the hand."""
 
     DEFAULT_MODES = ("relocate",)
 
 
-@register_env("UniCross-Rotate-v1", max_episode_steps=EPISODE_STEPS["rotate"])
+@register_task("UniCross-Rotate-v1", max_episode_steps=EPISODE_STEPS["rotate"])
 class RotateEnv(UniCrossEnv):
     """Rotate a grasped wrappable object in hand about ``axis`` of the hand frame."""
 
@@ -39,7 +39,7 @@ class RotateEnv(UniCrossEnv):
         super().__init__(*args, modes=(f"rotate_{axis}",), **kwargs)
 
 
-@register_env("UniCross-Translate-v1", max_episode_steps=EPISODE_STEPS["translate"])
+@register_task("UniCross-Translate-v1", max_episode_steps=EPISODE_STEPS["translate"])
 class TranslateEnv(UniCrossEnv):
     """Translate a grasped elongated object in hand along ``direction`` (hand-frame z)."""
 
@@ -51,7 +51,7 @@ class TranslateEnv(UniCrossEnv):
         super().__init__(*args, modes=(f"translate_{direction}",), **kwargs)
 
 
-@register_env("UniCross-MultiSkill-v1", max_episode_steps=max(EPISODE_STEPS.values()))
+@register_task("UniCross-MultiSkill-v1", max_episode_steps=max(EPISODE_STEPS.values()))
 class MultiSkillEnv(UniCrossEnv):
     """All ten modes at once: each parallel env holds one valid (object, mode) pair, spread
     uniformly; ``env.unwrapped.mode`` is the per-env mode tensor. Episodes are truncated per env

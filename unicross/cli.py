@@ -5,6 +5,7 @@
     unicross rollout --task ID ...        run random or zero actions and print per-term rewards
     unicross train --skill SKILL ...      train one expert with PPO (resumable)
     unicross distill --experts DIR ...    DAgger distillation of the ten experts into one student
+    unicross chain --policy P --sequence grasp,relocate,rotate:x+   one continuous long-horizon episode
     unicross eval --policy P ...          the paper's evaluation protocols -> JSON + table
     unicross report FILES...              assemble eval results into the paper's tables
     unicross render TRAJ --out V.mp4      draw a trajectory file (no GPU needed)
@@ -226,6 +227,33 @@ def _cmd_distill(args) -> int:
     return 0
 
 
+def _cmd_chain(args) -> int:
+    from unicross import evaluation as E
+    from unicross.objects import get_object_set
+    from unicross.tasks.chain import parse_sequence
+    if args.sequence:
+        parse_sequence(args.sequence)  # validates before any simulation
+    objs = get_object_set(args.objects, limit=args.limit)
+    policy, desc = E.resolve_policy(args.policy, args.hand, seed=args.seed)
+    videos = 1 if args.video else 0
+    video_dir = Path(args.video).parent if args.video else None
+    trials = E.run_chain(policy, objs, args.sequence, hand=args.hand, trials_per_object=args.trials_per_object,
+                         seed=args.seed, videos=videos, video_dir=video_dir)
+    for t in trials:
+        phases = ", ".join(f"{m}: {'ok' if s else 'FAIL'}" for m, s in zip(t["sequence"], t["phase_success"]))
+        print(f"{t['object']} trial {t['trial']}: {phases} -> {'SUCCESS' if t['overall'] else 'failure'}")
+    summary = E.summarize_chain(trials)
+    print(E.chain_table(summary))
+    if args.video and trials:
+        made = sorted(video_dir.glob(f"chain_{trials[0]['object']}_0.mp4"))
+        if made:
+            made[0].replace(args.video)
+            print(f"video: {args.video}")
+    if args.out:
+        Path(args.out).write_text(json.dumps(dict(policy=desc, trials=trials, summary=summary), indent=1))
+    return 0
+
+
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(prog="unicross", description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = p.add_subparsers(dest="cmd", required=True)
@@ -295,6 +323,18 @@ def main(argv=None) -> int:
     s.add_argument("--set", action="append", metavar="SECTION.KEY=VALUE", help="override configs/dagger.yaml")
     s.add_argument("--resume", action="store_true")
     s.set_defaults(fn=_cmd_distill)
+    s = sub.add_parser("chain", help="long-horizon skill chaining with one policy; prints per-phase outcomes")
+    s.add_argument("--policy", required=True, help="student/expert checkpoint, or zero | random")
+    s.add_argument("--sequence", default=None,
+                   help="e.g. grasp,relocate,rotate:x+ (default: the paper's protocol, random in-hand axis)")
+    s.add_argument("--objects", default="test")
+    s.add_argument("--limit", type=int, default=1)
+    s.add_argument("--trials-per-object", type=int, default=1)
+    s.add_argument("--hand", default="allegro")
+    s.add_argument("--seed", type=int, default=0)
+    s.add_argument("--video", default=None, help="record the first trial and render it to this .mp4")
+    s.add_argument("--out", default=None, help="JSON with every trial")
+    s.set_defaults(fn=_cmd_chain)
     s = sub.add_parser("train", help="train one expert with PPO (TorchRL); resumable")
     s.add_argument("--skill", choices=["grasp", "relocate", "rotate", "translate"], default=None)
     s.add_argument("--axis", default=None, help="rotate: x+,x-,y+,y-,z+,z-; translate: z+,z-")

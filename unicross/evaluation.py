@@ -41,6 +41,7 @@ ENV_ID = dict(grasp="UniCross-Grasp-v1", relocate="UniCross-Relocate-v1", rotate
 CATEGORY = dict(grasp=None, relocate=None, rotate="wrappable", translate="elongated")
 
 PolicyFn = Callable[[dict, object], torch.Tensor]
+SHORT_NAMES = dict(grasp="Gr.", relocate="Re.", rotate="Rot.", translate="Trans.")
 
 
 # ----------------------------------------------------------------------------- policies
@@ -246,4 +247,81 @@ def markdown_table(rows: Dict[str, Dict[str, dict]]) -> str:
     lines = ["| Setting | " + " | ".join(COLUMNS) + " |", "|---|" + "---|" * len(COLUMNS)]
     for label, summ in rows.items():
         lines.append(f"| {label} | " + " | ".join(table_row(summ)) + " |")
+    return "\n".join(lines)
+
+
+# ----------------------------------------------------------------------------- long horizon
+def run_chain(policy: PolicyFn, objects: Sequence[ObjectSpec], sequence: Optional[str] = None,
+              hand: str = "allegro", trials_per_object: int = 25, seed: int = 0, randomize: bool = False,
+              progress: bool = True, videos: int = 0, video_dir=None) -> List[dict]:
+    """Long-horizon protocol: grasp -> relocate -> in-hand from random table poses in one episode.
+
+    ``sequence`` None: the paper's protocol (wrappable objects: rotate about a random axis;
+    elongated: translate along a random direction); otherwise e.g. 'grasp,relocate,rotate:x+'."""
+    from unicross.tasks.chain import parse_sequence
+    rng = torch.Generator().manual_seed(seed)
+    trials = []
+    bar = tqdm(total=len(objects) * trials_per_object, desc="eval chain", disable=not progress)
+    for oi, obj in enumerate(objects):
+        for k in range(trials_per_object):
+            if sequence is None:
+                axes = F.ROTATE_AXES if obj.category == "wrappable" else F.TRANSLATE_DIRECTIONS
+                skill = "rotate" if obj.category == "wrappable" else "translate"
+                seq = f"grasp,relocate,{skill}:{axes[int(torch.randint(len(axes), (1,), generator=rng))]}"
+            else:
+                seq = sequence
+            modes = parse_sequence(seq)
+            env = gym.make("UniCross-Chain-v1", obs_mode="state_dict", sim_backend="physx_cpu", render_backend="none",
+                           hand=hand, objects=[obj], randomize=randomize, sequence=modes)
+            u = env.unwrapped
+            trial_seed = seed * 1_000_003 + oi * 10_007 + k
+            obs, info = u.reset(seed=trial_seed)
+            rec = None
+            if len(trials) < videos:
+                from unicross.trajectory import TrajectoryRecorder
+                rec = TrajectoryRecorder(u, task_id="UniCross-Chain-v1")
+                rec.record(f"phase 1/{len(modes)}")
+            phase_of_drop = None
+            for t in range(u.phase_ends[-1]):
+                obs, _, term, trunc, info = u.step(policy(obs, u))
+                if rec is not None:
+                    rec.record(f"phase {u.phase + 1}/{len(modes)}")
+                if bool(term.all()):
+                    phase_of_drop = u.phase
+                    break
+            ps = u.phase_success[0].tolist()
+            trials.append(dict(object=obj.name, category=obj.category, sequence=modes, trial=k, seed=trial_seed,
+                               phase_success=ps, overall=all(ps), dropped_in_phase=phase_of_drop,
+                               steps=int(u.elapsed_steps[0])))
+            if rec is not None:
+                _save_video(rec, video_dir, f"chain_{obj.name}_{k}")
+            env.close()
+            bar.update(1)
+    bar.close()
+    return trials
+
+
+def summarize_chain(trials: List[dict]) -> Dict[str, dict]:
+    """Per sequence kind (Gr.+Re.+Rot. / Gr.+Re.+Trans.): per-phase and overall SR."""
+    groups: Dict[str, List[dict]] = {}
+    for t in trials:
+        kind = " + ".join(SHORT_NAMES[F.mode_skill(m)] for m in t["sequence"])
+        groups.setdefault(kind, []).append(t)
+    out = {}
+    for kind, ts in groups.items():
+        ps = torch.tensor([t["phase_success"] for t in ts], dtype=torch.bool)
+        # a phase counts only if every phase before it succeeded (the chain continues from it)
+        reached = torch.cumprod(ps.int(), dim=1).bool()
+        out[kind] = dict(phases=[M.success_summary(reached[:, i]) for i in range(ps.shape[1])],
+                         per_phase=[M.success_summary(ps[:, i]) for i in range(ps.shape[1])],
+                         overall=M.success_summary(ps.all(dim=1)), n=len(ts))
+    return out
+
+
+def chain_table(summary: Dict[str, dict]) -> str:
+    lines = ["| Sequence | Grasp SR | Relocate SR | In-hand SR | Overall SR |", "|---|---|---|---|---|"]
+    for kind, s in summary.items():
+        cells = [f"{p['sr']:.1f} (n={p['n']})" for p in s["per_phase"]]
+        lines.append(f"| {kind} | " + " | ".join(cells[:3]) + f" | {s['overall']['sr']:.1f} "
+                     f"[{s['overall']['ci95'][0]:.0f}-{s['overall']['ci95'][1]:.0f}] (n={s['n']}) |")
     return "\n".join(lines)

@@ -1,0 +1,78 @@
+"""Skill chaining: mode switches at the right step, continuous state across the switch, per-phase success."""
+import pytest
+import torch
+
+from conftest import make
+from unicross import formulation as F
+from unicross.scripted_grasp import ScriptedGrasp
+from unicross.tasks.chain import parse_sequence
+
+
+def test_sequence_parsing():
+    assert parse_sequence("grasp,relocate,rotate:x+") == ["grasp", "relocate", "rotate_x+"]
+    with pytest.raises(ValueError, match="valid axes"):
+        parse_sequence("grasp,rotate:w+")
+    with pytest.raises(ValueError, match="starts with grasp"):
+        parse_sequence("relocate,rotate:x+")
+
+
+def test_chain_switches_modes_continuously():
+    env = make("UniCross-Chain-v1", objects="test-wrappable", sequence="grasp,relocate,rotate:y-",
+               phase_steps=dict(grasp=60, relocate=10, rotate=10), randomize=False)
+    u = env.unwrapped
+    env.reset(seed=1)
+    assert u.phase_ends == [60, 70, 80] and u.mode.item() == F.MODES.index("grasp")
+    policy = ScriptedGrasp(u)
+    modes, info = [], None
+    for t in range(80):
+        a = policy() if t < 55 else torch.zeros(1, 22)
+        before = u.sensor.poses()
+        root_before = u.root_p.clone()
+        _, _, term, trunc, info = env.step(a)
+        modes.append(u.mode.item())
+        if t + 1 in (60, 70):  # the switch happened inside this step: compare the state it left
+            after = u.sensor.poses()
+            mid = u.agent.robot.get_qpos()
+            assert torch.count_nonzero(mid[:, u._qidx[:6]]) == 0            # virtual joints re-based to zero
+            assert not torch.allclose(u.root_p, root_before)               # new root frame = current hand
+            assert torch.allclose(u.cur_rel.x_hr, torch.zeros(1, 3), atol=1e-5)
+        if term.any():
+            break
+    assert modes[:59] == [0] * 59 and modes[59] == F.MODES.index("relocate")
+    assert modes[69] == F.MODES.index("rotate_y-")
+    assert (trunc.all() or term.all()) and info["phase"].item() == 2  # ends at the last phase's end or on a drop
+    assert info["phase_success"].shape == (1, 3) and info["phase_success"][0, 0]  # the scripted grasp lifted it
+
+
+def test_no_teleport_across_the_switch():
+    env = make("UniCross-Chain-v1", objects="test-wrappable", sequence="grasp,relocate",
+               phase_steps=dict(grasp=58, relocate=5), randomize=False)
+    u = env.unwrapped
+    env.reset(seed=2)
+    policy = ScriptedGrasp(u)
+    for _ in range(57):
+        env.step(policy())
+    # step 58 ends the grasp phase; record the world state right before the switch is applied
+    from unicross.tasks import chain as C
+    seen = {}
+    orig = C.ChainEnv._switch_phase
+
+    def spy(self, k):
+        seen["before"] = [t.clone() for t in self.sensor.poses()]
+        seen["vel_before"] = self.agent.robot.links[0].get_linear_velocity().clone()
+        orig(self, k)
+        seen["after"] = [t.clone() for t in self.sensor.poses()]
+    C.ChainEnv._switch_phase = spy
+    try:
+        env.step(torch.zeros(22))
+    finally:
+        C.ChainEnv._switch_phase = orig
+    (p0, q0), (p1, q1) = seen["before"], seen["after"]
+    assert torch.allclose(p0, p1, atol=1e-5)                  # every link and the object stay put
+    assert torch.allclose(q0.abs(), q1.abs(), atol=1e-5)
+    hand = next(l for l in u.agent.robot.links if l.name == "hand_frame")
+    # velocities carry over: stepping on, the hand keeps moving smoothly (no jump)
+    v_after = hand.get_linear_velocity().clone()
+    env.step(torch.zeros(22))
+    v_next = hand.get_linear_velocity()
+    assert (v_next - v_after).norm() < 0.5
