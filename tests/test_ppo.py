@@ -104,3 +104,18 @@ def test_bad_input_fails_fast(tmp_path):
         PPOTrainer(tmp_path / "c", "translate", axis="x+", progress=False)
     with pytest.raises(FileNotFoundError, match="no checkpoint"):
         PPOTrainer(tmp_path / "d", resume=True, progress=False)
+
+
+def test_ablation_row_is_one_train_and_one_eval(tmp_path):
+    import json
+    from unicross.cli import main
+    run = tmp_path / "abl"
+    assert main(["train", "--skill", "grasp", "--out", str(run), "--num-envs", "1", "--total-frames", "32",
+                 "--ablation", "no_target_obs", "--set", "collector.horizon=16", "--set", "logging.eval_episodes=0",
+                 "--set", "env.object_limit=1", "--set", "optim.minibatch_size=16"]) == 0
+    out = tmp_path / "abl.json"
+    assert main(["eval", "--policy", str(run / "checkpoint.pt"), "--protocol", "grasp", "--objects", "train-wrappable",
+                 "--limit", "1", "--trials-per-object", "1", "--out", str(out)]) == 0
+    r = json.loads(out.read_text())
+    assert r["policy"]["ablation"] == {"no_target_obs": True}
+    assert main(["train", "--skill", "grasp", "--out", str(tmp_path / "x"), "--ablation", "no_fun"]) == 2

@@ -109,6 +109,9 @@ def _cmd_rollout(args) -> int:
     return 0
 
 
+ABLATIONS = ("no_target_obs", "no_target_action", "no_track_reward", "no_distance", "no_contact")
+
+
 def parse_sets(items) -> dict:
     """``section.key=value`` strings -> nested dict (values parsed as YAML)."""
     import yaml
@@ -137,6 +140,10 @@ def _cmd_train(args) -> int:
         scale.setdefault("collector", {})["total_frames"] = args.total_frames
     for section, values in scale.items():  # the scale flags win over --set
         overrides.setdefault(section, {}).update(values)
+    for flag in args.ablation or []:
+        if flag not in ABLATIONS:
+            raise ValueError(f"unknown ablation {flag!r}; valid: {list(ABLATIONS)}")
+        overrides.setdefault("env", {}).setdefault("task_config", {}).setdefault("ablation", {})[flag] = True
     if not args.resume and args.skill is None:
         raise ValueError("--skill is required (grasp, relocate, rotate, translate)")
     trainer = PPOTrainer(args.out, args.skill or "grasp", args.axis, args.hand, overrides=overrides or None,
@@ -168,7 +175,8 @@ def _cmd_eval(args) -> int:
         trials = E.run_protocol(p, policy, objs, hand=args.hand, trials_per_object=args.trials_per_object,
                                 seed=args.seed, disturb=args.disturb, randomize=args.randomize,
                                 grasp_dataset=args.grasps, original=args.original, videos=args.videos,
-                                video_dir=Path(args.out).parent / (Path(args.out).stem + "_videos"))
+                                video_dir=Path(args.out).parent / (Path(args.out).stem + "_videos"),
+                                ablation=desc.get("ablation"))
         result["trials"][p] = trials
         result["summaries"][p] = E.summarize(p, trials)
     out = Path(args.out)
@@ -346,6 +354,8 @@ def main(argv=None) -> int:
     s.add_argument("--backend", choices=["physx_cpu", "physx_cuda"], default=None)
     s.add_argument("--max-iterations", type=int, default=None, help="stop (and checkpoint) after this many iterations")
     s.add_argument("--set", action="append", metavar="SECTION.KEY=VALUE", help="override configs/ppo.yaml")
+    s.add_argument("--ablation", action="append", metavar="FLAG",
+                   help="one of the paper's ablations (repeatable): " + ", ".join(ABLATIONS))
     s.add_argument("--resume", action="store_true", help="continue the run in --out from its checkpoint")
     s.set_defaults(fn=_cmd_train)
     args = p.parse_args(argv)

@@ -95,14 +95,18 @@ def resolve_policy(spec: str, hand: str, seed: int = 0):
     if dict(ck["obs_dims"]) != expected or ck["n_act"] != spec_h.dof:
         raise ValueError(f"checkpoint {spec} expects observation {ck['obs_dims']} / action {ck['n_act']}, "
                          f"hand {hand!r} gives {expected} / {spec_h.dof}")
+    task_config = (ck.get("env_kwargs") or {}).get("config") or {}
     return (lambda obs, u: act(policy, obs)), dict(kind="checkpoint", path=str(spec), skill=ck.get("skill"),
-                                                   axis=ck.get("axis"), git_commit=ck.get("git_commit"))
+                                                   axis=ck.get("axis"), git_commit=ck.get("git_commit"),
+                                                   ablation=task_config.get("ablation", {}))
 
 
 # ----------------------------------------------------------------------------- one protocol
 def _env_for(protocol: str, axis: Optional[str], obj: ObjectSpec, hand: str, disturb: bool, randomize: bool,
-             grasp_dataset, original: bool):
+             grasp_dataset, original: bool, ablation: Optional[dict] = None):
     cfg = dict(episode_length={protocol: STEPS[protocol]})
+    if ablation:  # a policy trained without some inputs is evaluated with the same switches
+        cfg["ablation"] = dict(ablation)
     if disturb:
         cfg["disturbance"] = dict(max_scale=10.0)
     if original and protocol == "grasp":
@@ -123,7 +127,7 @@ def _env_for(protocol: str, axis: Optional[str], obj: ObjectSpec, hand: str, dis
 def run_protocol(protocol: str, policy: PolicyFn, objects: Sequence[ObjectSpec], hand: str = "allegro",
                  trials_per_object: int = 25, seed: int = 0, disturb: bool = False, randomize: bool = False,
                  grasp_dataset=None, original: bool = False, progress: bool = True,
-                 videos: int = 0, video_dir=None) -> List[dict]:
+                 videos: int = 0, video_dir=None, ablation: Optional[dict] = None) -> List[dict]:
     """All trials of one protocol; returns one dict per trial. The first ``videos`` trials are
     recorded as trajectory files (and rendered to mp4) in ``video_dir``."""
     if protocol not in PROTOCOLS:
@@ -138,7 +142,7 @@ def run_protocol(protocol: str, policy: PolicyFn, objects: Sequence[ObjectSpec],
     bar = tqdm(total=total, desc=f"eval {protocol}", disable=not progress)
     for oi, obj in enumerate(objs):
         for axis in AXES[protocol]:
-            env = _env_for(protocol, axis, obj, hand, disturb, randomize, grasp_dataset, original)
+            env = _env_for(protocol, axis, obj, hand, disturb, randomize, grasp_dataset, original, ablation)
             u = env.unwrapped
             axis_vec = F.MODE_AXES[F.mode_index(protocol, axis) if protocol in ("rotate", "translate") else 0]
             for k in range(trials_per_object):

@@ -64,6 +64,8 @@ def atomic_save(obj, path: Path) -> None:
 def env_kwargs_for(skill: str, axis: Optional[str], hand: str, env_cfg: dict) -> dict:
     F.mode_index(skill, axis)  # validates skill and axis before any simulation
     kw = dict(hand=hand, randomize=env_cfg["randomize"], reconfiguration_freq=env_cfg["reconfiguration_freq"])
+    if env_cfg.get("task_config"):
+        kw["config"] = env_cfg["task_config"]
     if env_cfg.get("objects"):
         kw["objects"] = env_cfg["objects"]
     if env_cfg.get("object_limit") is not None:
