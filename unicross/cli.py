@@ -292,7 +292,8 @@ def main(argv=None) -> int:
     s.add_argument("--zero", action="store_true", help="zero actions instead of random ones")
     s.set_defaults(fn=_cmd_rollout)
     s = sub.add_parser("eval", help="run the paper's evaluation protocols; writes JSON (every trial) and a table")
-    s.add_argument("--policy", required=True, help="checkpoint path, or zero | random | scripted-relocate")
+    s.add_argument("--policy", required=True,
+                   help="checkpoint path, or zero | random | scripted-grasp | scripted-relocate")
     s.add_argument("--protocol", default="all", help="grasp, relocate, rotate, translate (comma list) or all")
     s.add_argument("--objects", default="test", help="object set: train | test | unseen (| -wrappable/-elongated | mesh:<file>)")
     s.add_argument("--limit", type=int, default=None, help="first N objects per (category, type) group")

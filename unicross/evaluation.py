@@ -76,6 +76,18 @@ def scripted_relocate_policy(obs, u, tighten: float = 0.1) -> torch.Tensor:
     return a.clamp(-1.0, 1.0)
 
 
+def make_scripted_grasp_policy() -> PolicyFn:
+    """The scripted grasp synthesiser as a policy (descend, close, lift, hold); restarts at each reset."""
+    from unicross.scripted_grasp import ScriptedGrasp
+    state = {}
+
+    def policy(obs, u):
+        if int(u.elapsed_steps[0]) == 0 or state.get("env") is not u:
+            state["env"], state["script"] = u, ScriptedGrasp(u)
+        return state["script"]()
+    return policy
+
+
 def resolve_policy(spec: str, hand: str, seed: int = 0):
     """(policy_fn, description). Checkpoints are checked against the hand before any simulation."""
     if spec == "zero":
@@ -84,6 +96,8 @@ def resolve_policy(spec: str, hand: str, seed: int = 0):
         return make_random_policy(seed), dict(kind="random")
     if spec == "scripted-relocate":
         return scripted_relocate_policy, dict(kind="scripted-relocate")
+    if spec == "scripted-grasp":
+        return make_scripted_grasp_policy(), dict(kind="scripted-grasp")
     from unicross.rl.policy_io import act, load_policy
     from unicross.robots.hand import load_hand
     policy, ck = load_policy(spec)
