@@ -106,12 +106,36 @@ class HandSpec:
         return p if p.is_absolute() else (CONFIG_DIR / "hands" / p).resolve()
 
 
+_REGISTERED: Dict[str, HandSpec] = {}
+
+
 def available_hands() -> List[str]:
-    return sorted(p.stem for p in (CONFIG_DIR / "hands").glob("*.yaml"))
+    return sorted({p.stem for p in (CONFIG_DIR / "hands").glob("*.yaml")} | set(_REGISTERED))
+
+
+def register_hand(description) -> HandSpec:
+    """Add a hand at run time from a YAML path, a dict or a HandSpec (same fields as
+    ``configs/hands/allegro.yaml``); tasks, training and evaluation then accept its name."""
+    if isinstance(description, HandSpec):
+        spec = description
+    else:
+        if isinstance(description, (str, Path)):
+            with open(description) as f:
+                description = yaml.safe_load(f)
+        try:
+            spec = HandSpec(**description)
+        except TypeError as e:
+            raise ValueError(f"invalid hand description: {e}") from None
+    if spec.urdf and not Path(spec.urdf).is_absolute() and not spec.urdf.startswith("mani_skill://"):
+        raise ValueError("a registered hand needs an absolute urdf path or a mani_skill:// one")
+    _REGISTERED[spec.name] = spec
+    return spec
 
 
 def load_hand(name: str) -> HandSpec:
-    """Load a hand description by name (``configs/hands/<name>.yaml``)."""
+    """A hand description by name: registered at run time, or ``configs/hands/<name>.yaml``."""
+    if name in _REGISTERED:
+        return copy.deepcopy(_REGISTERED[name])
     path = CONFIG_DIR / "hands" / f"{name}.yaml"
     if not path.exists():
         raise ValueError(f"unknown hand {name!r}; valid hands: {available_hands()}")

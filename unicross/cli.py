@@ -1,6 +1,7 @@
 """``unicross`` command line.
 
     unicross info                         task ids, observation/action sizes, the target table
+    unicross hands                        registered hands and their DoF
     unicross grasps --objects SET ...     synthesise a grasp-state dataset (scripted) and hold-test it
     unicross rollout --task ID ...        run random or zero actions and print per-term rewards
     unicross train --skill SKILL ...      train one expert with PPO (resumable)
@@ -37,6 +38,15 @@ def _cmd_info(args) -> int:
     print("target table (paper Table 1):")
     for skill, kinds in F.target_table().items():
         print(f"  {skill:10s} " + "  ".join(f"{k}: {', '.join(v) or '-'}" for k, v in kinds.items()))
+    return 0
+
+
+def _cmd_hands(args) -> int:
+    from unicross.robots.hand import available_hands, load_hand
+    print(f"{'hand':12s} {'DoF':>4s} {'wrist':>6s} {'fingers':>8s} {'contact links':>14s}  urdf")
+    for name in available_hands():
+        s = load_hand(name)
+        print(f"{name:12s} {s.dof:4d} {6:6d} {len(s.finger_joints):8d} {len(s.contact_links):14d}  {s.urdf}")
     return 0
 
 
@@ -268,6 +278,8 @@ def main(argv=None) -> int:
     s = sub.add_parser("info", help="print task ids, sizes and the target table")
     s.add_argument("--hand", default="allegro")
     s.set_defaults(fn=_cmd_info)
+    s = sub.add_parser("hands", help="list the registered hands with their DoF")
+    s.set_defaults(fn=_cmd_hands)
     s = sub.add_parser("grasps", help="build a grasp-state dataset (grasp expert, or the scripted synthesiser)")
     s.add_argument("--expert", default=None, help="grasp expert checkpoint (default: the scripted synthesiser)")
     s.add_argument("--objects", default="train", help="object set (train, test-wrappable, unseen, mesh:<file>, ...)")
