@@ -529,6 +529,10 @@ class UniCrossEnv(BaseEnv):
         # drop and success (DESIGN §6)
         dist = m["link_distance"]
         drop = dist.min(dim=-1).values > self.cfg["drop_threshold"]
+        # a grasp can only drop what it lifted: before the lift phase the object rests on the table
+        lift_after = self.cfg["grasp"]["lift_after"]
+        grasp_lifting = (self.elapsed_steps >= lift_after) if lift_after is not None else torch.zeros_like(drop)
+        drop = drop & ((skill != 0) | grasp_lifting)
         self.ever_dropped = self.ever_dropped | drop
         contact = m["force"] > self.cfg["contact_force_threshold"]
         lifted = (m["obj_p"][:, 2] - self.obj_z0) > self.cfg["grasp"]["lift_success"]
@@ -546,7 +550,8 @@ class UniCrossEnv(BaseEnv):
         success = success_by_skill.gather(1, skill[:, None])[:, 0] & ok
         # measurements for observation and reward
         force_c = m["force"].clamp(max=self.cfg["force_clip"])
-        speed = torch.where(is_rot, (self.obj_angvel_h * self.axis).sum(-1), (self.obj_vel_h * self.axis).sum(-1))
+        # motion along the axis the last action was asked to follow
+        speed = torch.where(is_rot, (self.obj_angvel_h * axis_prev).sum(-1), (self.obj_vel_h * axis_prev).sum(-1))
         meas = dict(link_distance=dist, contact=contact, force_clipped=force_c, speed_along_axis=speed,
                     speed_cap=self._speed_cap[self.mode], relational=cur, reward_targets=reward_targets,
                     finger_qpos=m["qpos"][:, 6:], finger_qpos0=self.finger_q0, hand_lin_vel=self.hand_vel,

@@ -111,6 +111,8 @@ class PPOTrainer:
         self.horizon = cfg["collector"]["horizon"] or DEFAULT_HORIZON[skill]
         self._seed_everything(cfg["seed"])
         ec = cfg["env"]
+        if ec["backend"] == "physx_cpu":  # leave the cores to the env worker processes
+            torch.set_num_threads(max(1, (os.cpu_count() or 1) - ec["num_envs"]))
         self.env = make_env(self.env_id, self.env_kwargs, ec["num_envs"], ec["backend"])
         self.env.set_seed(cfg["seed"])
         self.device = self.env.device
