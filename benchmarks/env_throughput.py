@@ -26,7 +26,6 @@ sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 import gymnasium as gym  # noqa: E402
 
 import unicross  # noqa: E402,F401
-from unicross.grasps import GraspSet, default_grasp_path  # noqa: E402
 from unicross.scripted_grasp import ScriptedGrasp, synthesize  # noqa: E402
 from unicross.objects import get_object_set  # noqa: E402
 

@@ -16,7 +16,6 @@ import sys
 import tempfile
 import time
 
-import torch
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 from unicross.rl.ppo import PPOTrainer  # noqa: E402

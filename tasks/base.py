@@ -14,7 +14,6 @@ Per control step (``step``):
 from __future__ import annotations
 
 import math
-from pathlib import Path
 from typing import Any, Dict, Optional, Sequence
 
 import numpy as np
@@ -36,7 +35,7 @@ from unicross.geometry import (
     quat_angle, quat_inv, quat_mul, quat_positive, relative_pose,
 )
 from unicross.grasps import GraspSet, default_grasp_path
-from unicross.objects import ObjectSpec, resolve_objects
+from unicross.objects import resolve_objects
 from unicross.rewards import RewardTerms
 from unicross.robots.hand import HAND_FRAME_LINK, HandSpec, load_hand, register_hand_agent
 from unicross.sensing import HandObjectSensor

@@ -26,12 +26,10 @@ def test_chain_switches_modes_continuously():
     modes, info = [], None
     for t in range(80):
         a = policy() if t < 55 else torch.zeros(1, 22)
-        before = u.sensor.poses()
         root_before = u.root_p.clone()
         _, _, term, trunc, info = env.step(a)
         modes.append(u.mode.item())
         if t + 1 in (60, 70):  # the switch happened inside this step: compare the state it left
-            after = u.sensor.poses()
             mid = u.agent.robot.get_qpos()
             assert torch.count_nonzero(mid[:, u._qidx[:6]]) == 0            # virtual joints re-based to zero
             assert not torch.allclose(u.root_p, root_before)               # new root frame = current hand

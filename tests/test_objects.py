@@ -1,5 +1,4 @@
 """Object sets and user meshes."""
-import numpy as np
 import pytest
 import torch
 import trimesh

@@ -1,5 +1,4 @@
 """TorchRL side: env specs, a tiny PPO run that learns weights, resume after interruption."""
-import os
 import signal
 import subprocess
 import sys

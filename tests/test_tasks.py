@@ -1,7 +1,5 @@
 """The ManiSkill tasks: spaces, determinism, state round trips, targets, contacts, drops, ablations."""
-import math
 
-import numpy as np
 import pytest
 import torch
 

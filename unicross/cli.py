@@ -23,7 +23,6 @@ from pathlib import Path
 
 
 def _cmd_info(args) -> int:
-    import gymnasium as gym
     import unicross
     from unicross import formulation as F
     from unicross.robots.hand import available_hands, load_hand

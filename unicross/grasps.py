@@ -31,6 +31,20 @@ FORMAT = "unicross-grasps/1"
 KEYS = ("finger_qpos", "finger_target", "wrist_pose", "object_pose_hand", "object_id")
 
 
+def empty_rows() -> Dict[str, list]:
+    return {k: [] for k in KEYS}
+
+
+def from_rows(hand: str, object_names: Sequence[str], rows: Dict[str, list], tried: Dict[str, int],
+              kept: Dict[str, int], source: str):
+    """(GraspSet, stats) from per-grasp rows collected by a grasp builder (scripted or expert)."""
+    if not rows["object_id"]:
+        raise RuntimeError(f"the {source} grasp builder produced no grasp")
+    data = TensorDict({k: torch.stack(v) for k, v in rows.items()}, batch_size=[len(rows["object_id"])])
+    stats = dict(tried=tried, kept=kept, success_rate=sum(kept.values()) / max(1, sum(tried.values())))
+    return GraspSet(hand, list(object_names), data, source=source), stats
+
+
 def default_grasp_path(hand: str) -> Path:
     """The grasp dataset shipped with the project for ``hand`` (``configs/grasps/<hand>.pt``)."""
     return CONFIG_DIR / "grasps" / f"{hand}.pt"

@@ -15,17 +15,14 @@ wrist pose, object pose in the hand frame) is the grasp dataset format of :mod:`
 """
 from __future__ import annotations
 
-import math
 from typing import Optional, Sequence
 
 import gymnasium as gym
-import numpy as np
 import torch
-from tensordict import TensorDict
 from tqdm import tqdm
 
 from unicross.geometry import quat_apply, quat_inv
-from unicross.grasps import GraspSet
+from unicross.grasps import GraspSet, empty_rows, from_rows
 from unicross.objects import ObjectSpec
 
 PHASES = dict(descend=14, close=14, settle=6)
@@ -92,7 +89,7 @@ def synthesize(hand: str, objects: Sequence[ObjectSpec], per_object: int, seed: 
     """
     import unicross  # noqa: F401  (registers the tasks)
     max_tries = max_tries or 2 * per_object
-    rows = {k: [] for k in ("finger_qpos", "finger_target", "wrist_pose", "object_pose_hand", "object_id")}
+    rows = empty_rows()
     names = [o.name for o in objects]
     tried = {n: 0 for n in names}
     kept = {n: 0 for n in names}
@@ -122,11 +119,7 @@ def synthesize(hand: str, objects: Sequence[ObjectSpec], per_object: int, seed: 
                 bar.update(1)
         env.close()
     bar.close()
-    if not rows["object_id"]:
-        raise RuntimeError("the scripted synthesiser produced no grasp")
-    data = TensorDict({k: torch.stack(v) for k, v in rows.items()}, batch_size=[len(rows["object_id"])])
-    stats = dict(tried=tried, kept=kept, success_rate=sum(kept.values()) / max(1, sum(tried.values())))
-    return GraspSet(hand, names, data, source="scripted"), stats
+    return from_rows(hand, names, rows, tried, kept, source="scripted")
 
 
 def grasp_state(u, e: int, object_id: int) -> dict:

@@ -20,7 +20,7 @@ import dataclasses
 import hashlib
 import math
 from pathlib import Path
-from typing import List, Optional, Sequence, Tuple
+from typing import List, Optional, Tuple
 
 import numpy as np
 

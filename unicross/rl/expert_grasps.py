@@ -10,11 +10,9 @@ from __future__ import annotations
 from typing import Sequence
 
 import gymnasium as gym
-import torch
-from tensordict import TensorDict
 from tqdm import tqdm
 
-from unicross.grasps import GraspSet
+from unicross.grasps import empty_rows, from_rows
 from unicross.objects import ObjectSpec
 from unicross.rl.policy_io import act, load_policy
 from unicross.scripted_grasp import grasp_state
@@ -28,7 +26,7 @@ def expert_grasps(ckpt_path, objects: Sequence[ObjectSpec], per_object: int, see
         raise ValueError(f"{ckpt_path} is a {ck.get('skill')!r} expert, not a grasp expert")
     hand = ck["hand"]
     max_tries = max_tries or 4 * per_object
-    rows = {k: [] for k in ("finger_qpos", "finger_target", "wrist_pose", "object_pose_hand", "object_id")}
+    rows = empty_rows()
     tried, kept = {}, {}
     bar = tqdm(total=len(objects) * per_object, desc="expert grasps", disable=not progress)
     for oi, obj in enumerate(objects):
@@ -54,8 +52,4 @@ def expert_grasps(ckpt_path, objects: Sequence[ObjectSpec], per_object: int, see
                 bar.update(1)
         env.close()
     bar.close()
-    if not rows["object_id"]:
-        raise RuntimeError(f"the expert {ckpt_path} produced no successful, settled grasp")
-    data = TensorDict({k: torch.stack(v) for k, v in rows.items()}, batch_size=[len(rows["object_id"])])
-    stats = dict(tried=tried, kept=kept, success_rate=sum(kept.values()) / max(1, sum(tried.values())))
-    return GraspSet(hand, [o.name for o in objects], data, source=f"expert:{ckpt_path}"), stats
+    return from_rows(hand, [o.name for o in objects], rows, tried, kept, source=f"expert:{ckpt_path}")
