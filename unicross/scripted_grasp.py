@@ -39,10 +39,10 @@ def closing_delta(hand_spec) -> torch.Tensor:
 
 
 class ScriptedGrasp:
-    """The scripted policy; call it with the unwrapped env to get the next normalised action."""
+    """The scripted policy for the unwrapped grasp task ``u`` right after its reset; each call
+    returns the next normalised action."""
 
-    def __init__(self, env, lift_height: float = 0.15, hold_seconds: float = 2.0):
-        u = env
+    def __init__(self, u, lift_height: float = 0.15, hold_seconds: float = 2.0):
         self.env = u
         self.lift_steps = int(round(1.0 / u.control_dt))
         self.hold_steps = int(round(hold_seconds / u.control_dt))
