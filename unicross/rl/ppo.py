@@ -66,6 +66,8 @@ def env_kwargs_for(skill: str, axis: Optional[str], hand: str, env_cfg: dict) ->
     kw = dict(hand=hand, randomize=env_cfg["randomize"], reconfiguration_freq=env_cfg["reconfiguration_freq"])
     if env_cfg.get("task_config"):
         kw["config"] = env_cfg["task_config"]
+    if env_cfg.get("reward_config"):
+        kw["reward_config"] = env_cfg["reward_config"]
     if env_cfg.get("objects"):
         kw["objects"] = env_cfg["objects"]
     if env_cfg.get("object_limit") is not None:
