@@ -413,7 +413,7 @@ class UniCrossEnv(BaseEnv):
         self._stepped = True
         self._apply_command()
         obs, reward, _, _, info = super().step(None)  # drive targets are set; ManiSkill runs the substeps
-        terminated = info["fail"].clone()
+        terminated = info["fail"].clone() if self.cfg["terminate_on_drop"] else torch.zeros_like(info["fail"])
         truncated = self.elapsed_steps >= self.episode_length[self.mode]
         return obs, reward, terminated, truncated, info
 

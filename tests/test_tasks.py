@@ -311,3 +311,14 @@ def test_grasp_lift_phase_raises_the_wrist_at_the_set_speed():
     # 10 lifting steps at 0.2 m/s * 0.05 s: ~0.1 m (the position-controlled wrist lags a little)
     assert 0.05 < rise < 0.11
     env.close()
+
+
+def test_drop_without_termination_when_switched_off(grasp_file):
+    env = make("UniCross-Rotate-v1", grasp_file, config=dict(terminate_on_drop=False))
+    u = env.unwrapped
+    env.reset(seed=0)
+    pose = u.obj.pose
+    u.obj.set_pose(pose.__class__.create_from_pq(pose.p + torch.tensor([0.0, 0.0, -0.4]), pose.q))
+    _, _, term, _, info = env.step(torch.zeros(22))
+    assert info["drop"].all() and not term.any() and info["reward_drop"].item() < 0
+    env.close()
