@@ -12,15 +12,24 @@ if not CONFIG_DIR.exists():  # installed (non-editable): configs ship as unicros
     CONFIG_DIR = Path(__file__).resolve().parent / "configs"
 
 
-def deep_merge(base: dict, override: Optional[Mapping[str, Any]], path: str = "") -> dict:
+# sections that hold overrides of another config file: checked where they are applied, merged freely here
+FREE_FORM = ("task_config", "reward_config")
+
+
+def deep_merge(base: dict, override: Optional[Mapping[str, Any]], path: str = "", strict: bool = True) -> dict:
     """Return ``base`` updated by ``override``; unknown keys are an error (typos fail loudly),
-    except below an empty mapping in ``base``, which is free-form (e.g. ``task_config: {}``)."""
+    except inside the free-form sections (``FREE_FORM``, or an empty mapping in ``base``)."""
     out = copy.deepcopy(base)
     for k, v in (override or {}).items():
         if k not in out:
-            raise KeyError(f"unknown config key {path + k!r}; valid: {sorted(out)}")
-        if isinstance(out[k], dict) and out[k] and isinstance(v, Mapping):
-            out[k] = deep_merge(out[k], v, path + k + ".")
+            if strict:
+                raise KeyError(f"unknown config key {path + k!r}; valid: {sorted(out)}")
+            out[k] = copy.deepcopy(v)
+            continue
+        if isinstance(out[k], dict) and isinstance(v, Mapping) and (k in FREE_FORM or not out[k]):
+            out[k] = deep_merge(out[k], v, path + k + ".", strict=False)
+        elif isinstance(out[k], dict) and isinstance(v, Mapping):
+            out[k] = deep_merge(out[k], v, path + k + ".", strict=strict)
         else:
             out[k] = copy.deepcopy(v)
     return out
