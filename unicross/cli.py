@@ -137,18 +137,20 @@ def parse_sets(items) -> dict:
     return out
 
 
+def overrides_from(args, **flags) -> dict:
+    """``--set`` overrides plus the scale flags (which win): flags map "section.key" -> value."""
+    overrides = parse_sets(args.set)
+    for path, value in flags.items():
+        if value is not None:
+            section, key = path.split(".")
+            overrides.setdefault(section, {})[key] = value
+    return overrides
+
+
 def _cmd_train(args) -> int:
     from unicross.rl.ppo import PPOTrainer
-    overrides = parse_sets(args.set)
-    scale = {}
-    if args.num_envs is not None:
-        scale.setdefault("env", {})["num_envs"] = args.num_envs
-    if args.backend is not None:
-        scale.setdefault("env", {})["backend"] = args.backend
-    if args.total_frames is not None:
-        scale.setdefault("collector", {})["total_frames"] = args.total_frames
-    for section, values in scale.items():  # the scale flags win over --set
-        overrides.setdefault(section, {}).update(values)
+    overrides = overrides_from(args, **{"env.num_envs": args.num_envs, "env.backend": args.backend,
+                                        "collector.total_frames": args.total_frames})
     for flag in args.ablation or []:
         if flag not in ABLATIONS:
             raise ValueError(f"unknown ablation {flag!r}; valid: {list(ABLATIONS)}")
@@ -227,13 +229,8 @@ def _cmd_render(args) -> int:
 
 def _cmd_distill(args) -> int:
     from unicross.rl.dagger import DAggerTrainer
-    overrides = parse_sets(args.set)
-    if args.num_envs is not None:
-        overrides.setdefault("env", {})["num_envs"] = args.num_envs
-    if args.backend is not None:
-        overrides.setdefault("env", {})["backend"] = args.backend
-    if args.epochs is not None:
-        overrides.setdefault("optim", {})["epochs"] = args.epochs
+    overrides = overrides_from(args, **{"env.num_envs": args.num_envs, "env.backend": args.backend,
+                                        "optim.epochs": args.epochs})
     trainer = DAggerTrainer(args.out, args.experts, overrides=overrides or None, resume=args.resume)
     try:
         last = trainer.train()

@@ -28,11 +28,10 @@ from torchrl.envs.utils import ExplorationType, set_exploration_type
 from tqdm import tqdm
 
 from unicross import formulation as F
-from unicross.config import deep_merge, load_config
 from unicross.rl.env import make_env
 from unicross.rl.models import OBS_KEYS, make_models, obs_dims_from_spec
 from unicross.rl.policy_io import load_policy
-from unicross.rl.ppo import atomic_save, git_commit
+from unicross.rl.ppo import atomic_save, git_commit, open_run
 
 CKPT_NAME = "checkpoint.pt"
 
@@ -84,20 +83,11 @@ class DAggerTrainer:
     def __init__(self, run_dir, experts_dir=None, overrides: Optional[dict] = None, resume: bool = False,
                  progress: bool = True):
         self.run_dir = Path(run_dir)
-        ck_path = self.run_dir / CKPT_NAME
-        self.ckpt = None
-        if resume:
-            if not ck_path.exists():
-                raise FileNotFoundError(f"cannot resume: no checkpoint at {ck_path}")
-            self.ckpt = torch.load(ck_path, map_location="cpu", weights_only=False)
-            cfg = deep_merge(self.ckpt["config"], overrides)
+        if not resume and experts_dir is None:
+            raise ValueError("--experts is required")
+        self.ckpt, cfg = open_run(self.run_dir, resume, overrides, "dagger")
+        if self.ckpt is not None:
             experts_dir = experts_dir or self.ckpt["experts_dir"]
-        else:
-            if ck_path.exists():
-                raise FileExistsError(f"{ck_path} exists: pass --resume to continue it or choose another --out")
-            if experts_dir is None:
-                raise ValueError("--experts is required")
-            cfg = load_config("dagger", overrides)
         self.cfg, self.experts_dir, self.progress = cfg, str(experts_dir), progress
         modes = cfg["env"]["modes"] or list(F.MODES)
         paths = expert_paths(experts_dir, modes)  # refuses to start without every expert

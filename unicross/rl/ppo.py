@@ -61,6 +61,20 @@ def atomic_save(obj, path: Path) -> None:
     os.replace(tmp, path)
 
 
+def open_run(run_dir: Path, resume: bool, overrides: Optional[dict], config_name: str):
+    """(checkpoint or None, config) of a run directory: resume needs its checkpoint (whose config
+    the overrides update); a new run refuses to overwrite one and starts from ``configs/<name>``."""
+    ckpt_path = run_dir / CKPT_NAME
+    if resume:
+        if not ckpt_path.exists():
+            raise FileNotFoundError(f"cannot resume: no checkpoint at {ckpt_path}")
+        ckpt = torch.load(ckpt_path, map_location="cpu", weights_only=False)
+        return ckpt, deep_merge(ckpt["config"], overrides)
+    if ckpt_path.exists():
+        raise FileExistsError(f"{ckpt_path} exists: pass --resume to continue it or choose another --out")
+    return None, load_config(config_name, overrides)
+
+
 def env_kwargs_for(skill: str, axis: Optional[str], hand: str, env_cfg: dict) -> dict:
     F.mode_index(skill, axis)  # validates skill and axis before any simulation
     kw = dict(hand=hand, randomize=env_cfg["randomize"], reconfiguration_freq=env_cfg["reconfiguration_freq"])
@@ -90,18 +104,9 @@ class PPOTrainer:
     def __init__(self, run_dir, skill: str = "grasp", axis: Optional[str] = None, hand: str = "allegro",
                  overrides: Optional[dict] = None, resume: bool = False, progress: bool = True):
         self.run_dir = Path(run_dir)
-        ckpt_path = self.run_dir / CKPT_NAME
-        self.ckpt = None
-        if resume:
-            if not ckpt_path.exists():
-                raise FileNotFoundError(f"cannot resume: no checkpoint at {ckpt_path}")
-            self.ckpt = torch.load(ckpt_path, map_location="cpu", weights_only=False)
+        self.ckpt, cfg = open_run(self.run_dir, resume, overrides, "ppo")
+        if self.ckpt is not None:
             skill, axis, hand = self.ckpt["skill"], self.ckpt["axis"], self.ckpt["hand"]
-            cfg = deep_merge(self.ckpt["config"], overrides)
-        else:
-            if ckpt_path.exists():
-                raise FileExistsError(f"{ckpt_path} exists: pass --resume to continue it or choose another --out")
-            cfg = load_config("ppo", overrides)
         from unicross.robots.hand import load_hand
         load_hand(hand)  # validates
         self.skill, self.axis, self.hand, self.cfg = skill, axis, hand, cfg
