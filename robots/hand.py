@@ -17,9 +17,16 @@ Conventions (documented once, used everywhere):
   the hand pose in the root frame is ``x_h^r = (tx, ty, tz)`` and
   ``R_h^r = Rx(rx) @ Ry(ry) @ Rz(rz)``. Virtual joint values and (x_h^r, Euler(q_h^r)) are the
   same numbers, which is what the action mapping's wrist reference needs.
-* The *hand frame* h has its origin at the hand's palm point and the mount link's axes
-  (Allegro: +x out of the palm, +z along the fingers).
+* The *hand frame* h has its origin at the hand's palm point, +x out of the palm (palm normal),
+  +z along the fingers and +y = z x x (towards the index/thumb side of a right hand), for every
+  hand: a description gives ``palm_normal`` and ``finger_direction`` in its mount-link frame
+  and the fixed mount joint carries the rotation.
 * Hand links have gravity disabled: the virtual wrist acts like a gravity-compensated arm.
+* Coupled (mimic) joints, e.g. the Ability/Inspire distal joints, are not actions: each follower
+  gets a drive target ``multiplier * target(master) + offset`` (chains are resolved to an actuated
+  master), written next to the actuated targets every control step.
+* ``urdf: procedural://<name>`` builds the hand from code (:mod:`unicross.robots.procedural`),
+  e.g. the MANO-layout human hand and Sharpa Wave from their kinematic facts.
 """
 from __future__ import annotations
 
@@ -29,11 +36,12 @@ import hashlib
 import os
 import xml.etree.ElementTree as ET
 from pathlib import Path
-from typing import Dict, List
+from typing import Dict, List, Optional, Tuple
 
 import numpy as np
 import yaml
 
+PROCEDURAL = "procedural://"
 WRIST_JOINTS = ["wrist_tx", "wrist_ty", "wrist_tz", "wrist_rx", "wrist_ry", "wrist_rz"]
 HAND_FRAME_LINK = "hand_frame"
 from unicross.config import CONFIG_DIR
@@ -64,6 +72,38 @@ class HandSpec:
     wrist_limits: Dict[str, float]
     self_collision: bool = False
     object_scale: float = 1.0
+    # hand-frame axes in the mount-link frame (defaults: the mount link already follows the convention)
+    palm_normal: List[float] = dataclasses.field(default_factory=lambda: [1.0, 0.0, 0.0])
+    finger_direction: List[float] = dataclasses.field(default_factory=lambda: [0.0, 0.0, 1.0])
+    # follower joint -> {joint: leader, multiplier, offset}; followers are driven, not actions
+    mimic: Dict[str, Dict] = dataclasses.field(default_factory=dict)
+    # scripted grasp synthesiser: joint -> closing increment (rad); None = flex every joint but
+    # the first of each finger by 0.7 rad (Allegro-like four-joint fingers)
+    closing_delta: Optional[Dict[str, float]] = None
+    description: str = ""
+
+    def __post_init__(self):
+        dup = {j for j in self.finger_joints if self.finger_joints.count(j) > 1}
+        if dup:
+            raise ValueError(f"hand {self.name!r}: finger joints listed twice: {sorted(dup)}")
+        listed = [j for js in self.fingers.values() for j in js]
+        if sorted(listed) != sorted(self.finger_joints):
+            raise ValueError(f"hand {self.name!r}: `fingers` must partition `finger_joints` "
+                             f"(missing {sorted(set(self.finger_joints) - set(listed))}, "
+                             f"extra {sorted(set(listed) - set(self.finger_joints))})")
+        bad = [f for f in self.init_pose_finger_order if f not in self.fingers]
+        if bad:
+            raise ValueError(f"hand {self.name!r}: init_pose_finger_order names unknown fingers {bad}")
+        for cat, values in self.init_poses.items():
+            if len(values) != len(self.finger_joints):
+                raise ValueError(f"hand {self.name!r}: initial pose {cat!r} has {len(values)} values, "
+                                 f"expected {len(self.finger_joints)}")
+        for f, m in self.mimic.items():
+            if f in self.finger_joints or set(m) - {"joint", "multiplier", "offset"} or "joint" not in m:
+                raise ValueError(f"hand {self.name!r}: bad mimic entry {f!r}: {m} (a follower is not a "
+                                 f"finger joint; keys: joint, multiplier, offset)")
+        self.resolved_mimic()
+        self.mount_rotation()
 
     @property
     def joint_names(self) -> List[str]:
@@ -93,6 +133,48 @@ class HandSpec:
             raise ValueError(f"hand {self.name!r}: initial pose {category!r} has too many values")
         return np.array([by_name[j] for j in self.finger_joints], dtype=np.float32)
 
+    def resolved_mimic(self) -> List[Tuple[str, str, float, float]]:
+        """(follower, actuated finger joint, multiplier, offset) per mimic follower, with chains
+        (a follower of a follower) composed down to an actuated joint."""
+        out = []
+        for follower in self.mimic:
+            mult, off, j, seen = 1.0, 0.0, follower, {follower}
+            while j in self.mimic:
+                m = self.mimic[j]
+                k, o = float(m.get("multiplier", 1.0)), float(m.get("offset", 0.0))
+                mult, off = mult * k, off * k + o
+                j = m["joint"]
+                if j in seen:
+                    raise ValueError(f"hand {self.name!r}: mimic cycle through {j!r}")
+                seen.add(j)
+            if j not in self.finger_joints:
+                raise ValueError(f"hand {self.name!r}: mimic follower {follower!r} leads to {j!r}, "
+                                 f"which is not a finger joint")
+            out.append((follower, j, mult, off))
+        return out
+
+    def mount_rotation(self) -> np.ndarray:
+        """3x3 matrix whose columns are the hand-frame axes x, y, z in the mount-link frame."""
+        x = np.asarray(self.palm_normal, float)
+        z = np.asarray(self.finger_direction, float)
+        if x.shape != (3,) or z.shape != (3,) or np.linalg.norm(x) < 1e-9 or np.linalg.norm(z) < 1e-9:
+            raise ValueError(f"hand {self.name!r}: palm_normal and finger_direction must be non-zero 3-vectors")
+        x, z = x / np.linalg.norm(x), z / np.linalg.norm(z)
+        if abs(float(x @ z)) > 1e-3:
+            raise ValueError(f"hand {self.name!r}: palm_normal must be perpendicular to finger_direction")
+        return np.stack([x, np.cross(z, x), z], axis=1)
+
+    def closing_deltas(self) -> np.ndarray:
+        """Closing increment per finger joint (``finger_joints`` order) for the scripted grasp."""
+        if self.closing_delta is not None:
+            unknown = set(self.closing_delta) - set(self.finger_joints)
+            if unknown:
+                raise ValueError(f"hand {self.name!r}: closing_delta names unknown joints {sorted(unknown)}")
+            return np.array([float(self.closing_delta.get(j, 0.0)) for j in self.finger_joints], np.float32)
+        return np.array([0.0 if self.fingers[f].index(j) == 0 else 0.7
+                         for j in self.finger_joints
+                         for f in [next(f for f, js in self.fingers.items() if j in js)]], np.float32)
+
     def action_scales(self) -> np.ndarray:
         s = self.action_scale
         return np.array([s["wrist_translation"]] * 3 + [s["wrist_rotation"]] * 3
@@ -102,6 +184,9 @@ class HandSpec:
         if self.urdf.startswith("mani_skill://"):
             from mani_skill import PACKAGE_ASSET_DIR
             return Path(PACKAGE_ASSET_DIR) / self.urdf[len("mani_skill://"):]
+        if self.urdf.startswith(PROCEDURAL):
+            from unicross.robots.procedural import write_procedural_urdf
+            return write_procedural_urdf(self.urdf[len(PROCEDURAL):], cache_dir() / "robots")
         p = Path(self.urdf)
         return p if p.is_absolute() else (CONFIG_DIR / "hands" / p).resolve()
 
@@ -122,12 +207,9 @@ def register_hand(description) -> HandSpec:
         if isinstance(description, (str, Path)):
             with open(description) as f:
                 description = yaml.safe_load(f)
-        try:
-            spec = HandSpec(**description)
-        except TypeError as e:
-            raise ValueError(f"invalid hand description: {e}") from None
-    if spec.urdf and not Path(spec.urdf).is_absolute() and not spec.urdf.startswith("mani_skill://"):
-        raise ValueError("a registered hand needs an absolute urdf path or a mani_skill:// one")
+        spec = _spec_from_dict(description)
+    if spec.urdf and not Path(spec.urdf).is_absolute() and not spec.urdf.startswith(("mani_skill://", PROCEDURAL)):
+        raise ValueError("a registered hand needs an absolute urdf path, a mani_skill:// or a procedural:// one")
     _REGISTERED[spec.name] = spec
     return spec
 
@@ -141,7 +223,14 @@ def load_hand(name: str) -> HandSpec:
         raise ValueError(f"unknown hand {name!r}; valid hands: {available_hands()}")
     with open(path) as f:
         data = yaml.safe_load(f)
-    return HandSpec(**data)
+    return _spec_from_dict(data, source=path)
+
+
+def _spec_from_dict(data: dict, source=None) -> HandSpec:
+    try:
+        return HandSpec(**data)
+    except TypeError as e:
+        raise ValueError(f"invalid hand description{f' {source}' if source else ''}: {e}") from None
 
 
 # ----------------------------------------------------------------------------- URDF generation
@@ -152,6 +241,35 @@ def _virtual_link(name: str) -> ET.Element:
     ET.SubElement(inertial, "mass", value="0.01")
     ET.SubElement(inertial, "inertia", ixx="1e-6", iyy="1e-6", izz="1e-6", ixy="0", ixz="0", iyz="0")
     return link
+
+
+def matrix_to_rpy(R: np.ndarray) -> np.ndarray:
+    """URDF roll-pitch-yaw (R = Rz(yaw) Ry(pitch) Rx(roll)) of a rotation matrix."""
+    pitch = np.arcsin(np.clip(-R[2, 0], -1.0, 1.0))
+    if abs(np.cos(pitch)) > 1e-9:
+        return np.array([np.arctan2(R[2, 1], R[2, 2]), pitch, np.arctan2(R[1, 0], R[0, 0])])
+    return np.array([0.0, pitch, np.arctan2(-R[0, 1], R[1, 1])])  # gimbal lock: roll folded into yaw
+
+
+def _keep_subtree(robot: ET.Element, mount_link: str, src, hand: str) -> None:
+    """Drop every link and joint that is not below ``mount_link`` (e.g. a shipped hand's own
+    wrist joints, which the virtual wrist replaces)."""
+    links = {l.get("name") for l in robot.findall("link")}
+    if mount_link not in links:
+        raise ValueError(f"hand {hand!r}: mount link {mount_link!r} not in {src}")
+    children: Dict[str, List[ET.Element]] = {}
+    for j in robot.findall("joint"):
+        children.setdefault(j.find("parent").get("link"), []).append(j)
+    keep_links, keep_joints, stack = {mount_link}, set(), [mount_link]
+    while stack:
+        for j in children.get(stack.pop(), []):
+            keep_joints.add(id(j))
+            child = j.find("child").get("link")
+            keep_links.add(child)
+            stack.append(child)
+    for el in list(robot):
+        if (el.tag == "link" and el.get("name") not in keep_links) or (el.tag == "joint" and id(el) not in keep_joints):
+            robot.remove(el)
 
 
 def build_floating_urdf(spec: HandSpec) -> Path:
@@ -165,11 +283,20 @@ def build_floating_urdf(spec: HandSpec) -> Path:
         fn = mesh.get("filename")
         if fn and not fn.startswith(("/", "package://")):
             mesh.set("filename", str((src.parent / fn).resolve()))
+    _keep_subtree(robot, spec.mount_link, src, spec.name)
     joints = robot.findall("joint")
     names = {j.get("name") for j in joints}
-    for j in spec.finger_joints:
+    for j in list(spec.finger_joints) + list(spec.mimic):
         if j not in names:
-            raise ValueError(f"hand {spec.name!r}: finger joint {j!r} not in {src}")
+            raise ValueError(f"hand {spec.name!r}: joint {j!r} not below {spec.mount_link!r} in {src}")
+    loose = sorted(j.get("name") for j in joints if j.get("type") != "fixed"
+                   and j.get("name") not in spec.finger_joints and j.get("name") not in spec.mimic)
+    if loose:
+        raise ValueError(f"hand {spec.name!r}: joints {loose} are neither finger joints nor mimic "
+                         f"followers (they would have no drive)")
+    for j in joints:  # couplings are drive targets (see module docstring), not PhysX tendons
+        for m in j.findall("mimic"):
+            j.remove(m)
     old_children = list(robot)
     for c in old_children:
         robot.remove(c)
@@ -191,8 +318,10 @@ def build_floating_urdf(spec: HandSpec) -> Path:
     mount = ET.SubElement(robot, "joint", name="hand_mount", type="fixed")
     ET.SubElement(mount, "parent", link=HAND_FRAME_LINK)
     ET.SubElement(mount, "child", link=spec.mount_link)
-    pp = -np.asarray(spec.palm_point, dtype=float)
-    ET.SubElement(mount, "origin", xyz=" ".join(f"{v:.6f}" for v in pp), rpy="0 0 0")
+    R_hm = spec.mount_rotation().T  # mount-link axes in the hand frame
+    pp = -R_hm @ np.asarray(spec.palm_point, dtype=float)
+    rpy = matrix_to_rpy(R_hm)
+    ET.SubElement(mount, "origin", xyz=" ".join(f"{v:.6f}" for v in pp), rpy=" ".join(f"{v:.9f}" for v in rpy))
     for c in old_children:
         robot.append(c)
     text = ET.tostring(robot, encoding="unicode")
@@ -206,6 +335,23 @@ def build_floating_urdf(spec: HandSpec) -> Path:
     return out
 
 
+def finger_drive_gains(spec: HandSpec, urdf_path=None) -> Dict[str, Tuple[float, float, float]]:
+    """(stiffness, damping, force limit) of every finger joint and mimic follower.
+    ``pd.finger.force_limit: urdf`` takes each joint's ``<limit effort>`` from the hand's URDF."""
+    pd = spec.pd["finger"]
+    names = list(spec.finger_joints) + list(spec.mimic)
+    limit = pd["force_limit"]
+    if limit == "urdf":
+        root = ET.parse(urdf_path or build_floating_urdf(spec)).getroot()
+        effort = {j.get("name"): float(j.find("limit").get("effort")) for j in root.findall("joint")
+                  if j.find("limit") is not None and j.find("limit").get("effort") is not None}
+        missing = [n for n in names if n not in effort]
+        if missing:
+            raise ValueError(f"hand {spec.name!r}: force_limit 'urdf' but no effort for joints {missing}")
+        return {n: (float(pd["stiffness"]), float(pd["damping"]), effort[n]) for n in names}
+    return {n: (float(pd["stiffness"]), float(pd["damping"]), float(limit)) for n in names}
+
+
 # ----------------------------------------------------------------------------- agent registration
 _AGENT_CLASSES: Dict[str, type] = {}
 
@@ -213,8 +359,8 @@ _AGENT_CLASSES: Dict[str, type] = {}
 def register_hand_agent(spec: HandSpec) -> type:
     """Create (once) and register a ManiSkill agent class for the floating hand ``spec``.
 
-    The agent's only controller, ``pd_joint_pos``, takes absolute joint targets for all
-    ``spec.dof`` joints; the tasks map normalised actions to those targets.
+    The agent's only controller, ``pd_joint_pos``, sets up the PD drives of the ``spec.dof``
+    actuated joints and of the mimic followers; the tasks write the drive targets themselves.
     """
     if spec.uid in _AGENT_CLASSES:
         return _AGENT_CLASSES[spec.uid]
@@ -223,15 +369,14 @@ def register_hand_agent(spec: HandSpec) -> type:
     from mani_skill.agents.registration import REGISTERED_AGENTS, register_agent
 
     urdf_path = build_floating_urdf(spec)
-    pd = spec.pd
-    n_f = len(spec.finger_joints)
-    stiffness = [pd["wrist_translation"]["stiffness"]] * 3 + [pd["wrist_rotation"]["stiffness"]] * 3 \
-        + [pd["finger"]["stiffness"]] * n_f
-    damping = [pd["wrist_translation"]["damping"]] * 3 + [pd["wrist_rotation"]["damping"]] * 3 \
-        + [pd["finger"]["damping"]] * n_f
-    force_limit = [pd["wrist_translation"]["force_limit"]] * 3 + [pd["wrist_rotation"]["force_limit"]] * 3 \
-        + [pd["finger"]["force_limit"]] * n_f
-    joint_names = spec.joint_names
+    joint_names = spec.joint_names + list(spec.mimic)
+    gains = finger_drive_gains(spec, urdf_path)
+    stiffness = [spec.pd["wrist_translation"]["stiffness"]] * 3 + [spec.pd["wrist_rotation"]["stiffness"]] * 3 \
+        + [gains[j][0] for j in joint_names[6:]]
+    damping = [spec.pd["wrist_translation"]["damping"]] * 3 + [spec.pd["wrist_rotation"]["damping"]] * 3 \
+        + [gains[j][1] for j in joint_names[6:]]
+    force_limit = [spec.pd["wrist_translation"]["force_limit"]] * 3 + [spec.pd["wrist_rotation"]["force_limit"]] * 3 \
+        + [gains[j][2] for j in joint_names[6:]]
 
     class FloatingHand(BaseAgent):
         uid = spec.uid

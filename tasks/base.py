@@ -37,7 +37,7 @@ from unicross.geometry import (
 from unicross.grasps import GraspSet, default_grasp_path
 from unicross.objects import resolve_objects
 from unicross.rewards import RewardTerms
-from unicross.robots.hand import HAND_FRAME_LINK, HandSpec, load_hand, register_hand_agent
+from unicross.robots.hand import HAND_FRAME_LINK, HandSpec, finger_drive_gains, load_hand, register_hand_agent
 from unicross.sensing import HandObjectSensor
 
 CATEGORY_ID = {"wrappable": 0, "elongated": 1}
@@ -96,6 +96,8 @@ class UniCrossEnv(BaseEnv):
             if object_limit is not None:
                 from unicross.objects import get_object_set
                 objs = get_object_set(name, limit=object_limit)
+        # grasp datasets name objects as listed (unscaled); the scene holds them at the hand's scale
+        self.object_names = [o.name for o in objs]
         objs = [o.scaled(self.hand_spec.object_scale) for o in objs]
         self.object_specs = objs
         # valid (object, mode) pairs: rotate needs wrappable, translate elongated objects
@@ -120,7 +122,7 @@ class UniCrossEnv(BaseEnv):
             if self.grasps.hand != self.hand_spec.name:
                 raise ValueError(f"grasp dataset {path} is for hand {self.grasps.hand!r}, not {self.hand_spec.name!r}")
             have = {n for n, c in self.grasps.counts().items() if c > 0}
-            needed = {objs[oi].name for oi, mi in self._pairs if F.mode_skill(F.MODES[mi]) != "grasp"}
+            needed = {self.object_names[oi] for oi, mi in self._pairs if F.mode_skill(F.MODES[mi]) != "grasp"}
             missing = sorted(needed - have)
             if missing and len(missing) == len(needed):
                 raise ValueError(f"grasp dataset {path} has no grasps for the {len(missing)} object(s) of "
@@ -129,7 +131,7 @@ class UniCrossEnv(BaseEnv):
                 logger.warning(f"{len(missing)} object(s) have no grasp in {path} and are left out of the "
                                f"in-hand modes, e.g. {missing[:3]}")
                 self._pairs = [(oi, mi) for oi, mi in self._pairs
-                               if F.mode_skill(F.MODES[mi]) == "grasp" or objs[oi].name in have]
+                               if F.mode_skill(F.MODES[mi]) == "grasp" or self.object_names[oi] in have]
         register_hand_agent(self.hand_spec)
         super().__init__(*args, robot_uids=self.hand_spec.uid, **kwargs)
         n = self.hand_spec.dof
@@ -228,8 +230,19 @@ class UniCrossEnv(BaseEnv):
             probe.append(np.mean([s.local_pose.p for s in shapes], axis=0) if shapes else np.zeros(3))
         self.link_probe = torch.tensor(np.array(probe), dtype=torch.float32, device=dev)
         self.sensor = HandObjectSensor(self.scene, links[HAND_FRAME_LINK], self.contact_links, self.obj)
-        pd = spec.pd["finger"]
-        self._finger_pd = (pd["stiffness"], pd["damping"], pd["force_limit"])
+        gains = finger_drive_gains(spec, self.agent.urdf_path)
+        self._finger_pd = tuple(torch.tensor([gains[j][k] for j in spec.finger_joints], device=dev)
+                                for k in range(3))
+        # mimic followers: drive target = multiplier * target(leader) + offset, within limits
+        mimic = spec.resolved_mimic()
+        self._midx = torch.tensor([names.index(f) for f, *_ in mimic], dtype=torch.long, device=dev)
+        self._mimic_src = torch.tensor([6 + spec.finger_joints.index(m) for _, m, _, _ in mimic],
+                                       dtype=torch.long, device=dev)
+        self._mimic_k = torch.tensor([k for *_, k, _ in mimic], device=dev)
+        self._mimic_o = torch.tensor([o for *_, o in mimic], device=dev)
+        all_lim = robot.get_qlimits()[0].to(dev)
+        self._mimic_lim = all_lim[self._midx]
+        self._drive_idx = torch.cat([self._qidx, self._midx])
         self.episode_length = torch.tensor([self.cfg["episode_length"][F.mode_skill(m)] for m in F.MODES], device=dev)
         self.rewards = RewardTerms(self.reward_cfg, dev, self.cfg["ablation"]["no_track_reward"])
         self.motion = F.MotionParams(dt=self.control_dt, **self.cfg["motion"])
@@ -238,7 +251,7 @@ class UniCrossEnv(BaseEnv):
         self._world_up = torch.tensor([0.0, 0.0, 1.0], device=dev)
         if not self.gpu_sim_enabled:  # raw PhysX joints in hand-spec order (CPU: one env)
             art = robot._objs[0]
-            self._cpu_joints = [art.active_joints[i] for i in self._qidx.tolist()]
+            self._cpu_joints = [art.active_joints[i] for i in self._drive_idx.tolist()]
         self._alloc_buffers()
 
     def _alloc_buffers(self):
@@ -309,7 +322,7 @@ class UniCrossEnv(BaseEnv):
         hand_p, hand_q, obj_p, obj_q = hand_p_grasp, hand_q_grasp, obj_p_table, obj_q_table
         fq, ft = fq_grasp, fq_grasp
         if self.grasps is not None:
-            gs = self.grasps.sample(self.obj_index[env_idx], [o.name for o in self.object_specs], g)
+            gs = self.grasps.sample(self.obj_index[env_idx], self.object_names, g)
             random_q = _random_quaternion(b, g, dev)
             if self.cfg["in_hand_orientation"] == "palm_up":  # palm normal (+x_h) up, random yaw
                 psi = torch.rand(b, generator=g, device=dev) * 2 * math.pi
@@ -332,8 +345,7 @@ class UniCrossEnv(BaseEnv):
         # ---- apply to the simulation
         qpos = torch.zeros(b, spec.dof, device=dev)
         qpos[:, 6:] = fq
-        art_q = torch.zeros_like(qpos)
-        art_q[:, self._qidx] = qpos
+        art_q = self.articulation_qpos(qpos)
         self.agent.robot.set_qpos(art_q)
         self.agent.robot.set_qvel(torch.zeros_like(art_q))
         self.agent.robot.set_root_pose(Pose.create_from_pq(hand_p, hand_q))
@@ -385,13 +397,27 @@ class UniCrossEnv(BaseEnv):
         self._apply_command()
         return obs, info
 
+    def _follow(self, q: torch.Tensor) -> torch.Tensor:
+        """Mimic-follower values for actuated joint values ``q`` [B, dof] (spec order)."""
+        lim = self._mimic_lim
+        return torch.clamp(q[:, self._mimic_src] * self._mimic_k + self._mimic_o, lim[:, 0], lim[:, 1])
+
+    def articulation_qpos(self, qpos: torch.Tensor) -> torch.Tensor:
+        """Articulation-ordered joint positions from actuated ones [B, dof] (followers derived)."""
+        art_q = torch.zeros(qpos.shape[0], self.agent.robot.max_dof, device=qpos.device)
+        art_q[:, self._qidx] = qpos
+        art_q[:, self._midx] = self._follow(qpos)
+        return art_q
+
     def _apply_command(self):
-        """PD targets of all joints = the current command (one write on GPU, raw joints on CPU)."""
+        """PD targets of all driven joints = the current command and its mimic followers (one write
+        on GPU, raw joints on CPU)."""
+        targets = torch.cat([self.command, self._follow(self.command)], dim=-1)
         if self.gpu_sim_enabled:
-            self.agent.robot.set_joint_drive_targets(self.command, joint_indices=self._qidx)
+            self.agent.robot.set_joint_drive_targets(targets, joint_indices=self._drive_idx)
             self.scene.px.gpu_apply_articulation_target_position()
         else:
-            for joint, target in zip(self._cpu_joints, self.command[0].tolist()):
+            for joint, target in zip(self._cpu_joints, targets[0].tolist()):
                 joint.set_drive_target(target)
 
     # ------------------------------------------------------------------ stepping

@@ -64,7 +64,8 @@ def scripted_relocate_policy(obs, u, tighten: float = 0.1) -> torch.Tensor:
     a = torch.zeros(u.num_envs, u.hand_spec.dof, device=u.device)
     scale = u.action_scale
     from unicross.scripted_grasp import closing_delta
-    delta = closing_delta(u.hand_spec).to(u.device) / 0.7 * tighten
+    delta = closing_delta(u.hand_spec).to(u.device)
+    delta = delta / delta.abs().max().clamp(min=1e-6) * tighten  # closing direction, at most `tighten` rad
     q_des = torch.clamp(u.finger_q0 + delta, u.q_lower[6:], u.q_upper[6:])
     a[:, 6:] = (q_des - u.command[:, 6:]) / scale[6:]
     init = u.init_rel

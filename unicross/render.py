@@ -76,12 +76,14 @@ class HandModel:
         root = ET.parse(build_floating_urdf(self.spec)).getroot()
         self.visuals: Dict[str, List[Tuple[object, np.ndarray]]] = {}
         for link in root.findall("link"):
-            vis = []
-            for v in link.findall("visual"):
+            vis = []  # links without visuals (procedural hands) are drawn with their collision shapes
+            for v in link.findall("visual") or link.findall("collision"):
                 geom = v.find("geometry")
                 vis.append((geom, _origin(v.find("origin"))))
             self.visuals[link.get("name")] = vis
         self.children: Dict[str, list] = {}
+        self.limits = {j.get("name"): (float(j.find("limit").get("lower", "-inf")), float(j.find("limit").get("upper", "inf")))
+                       for j in root.findall("joint") if j.find("limit") is not None}
         for j in root.findall("joint"):
             parent, child = j.find("parent").get("link"), j.find("child").get("link")
             axis = j.find("axis")
@@ -91,20 +93,29 @@ class HandModel:
         self.root = HAND_FRAME_LINK
         self.index = {n: i for i, n in enumerate(self.spec.joint_names)}
 
+    def joint_values(self, qpos: np.ndarray) -> Dict[str, float]:
+        """Actuated joint values by name plus the mimic followers derived from them."""
+        values = {n: float(qpos[i]) for n, i in self.index.items()}
+        for follower, leader, k, o in self.spec.resolved_mimic():
+            lo, hi = self.limits.get(follower, (-np.inf, np.inf))
+            values[follower] = float(np.clip(k * values[leader] + o, lo, hi))
+        return values
+
     def link_poses(self, wrist_pose: np.ndarray, qpos: np.ndarray) -> Dict[str, np.ndarray]:
+        values = self.joint_values(qpos)
         out = {self.root: pose_matrix(wrist_pose)}
         stack = [self.root]
         while stack:
             parent = stack.pop()
             for name, kind, child, origin, axis in self.children.get(parent, []):
                 T = out[parent] @ origin
-                if kind in ("revolute", "continuous") and name in self.index:
+                if kind in ("revolute", "continuous") and name in values:
                     J = np.eye(4)
-                    J[:3, :3] = _axis_angle(axis, float(qpos[self.index[name]]))
+                    J[:3, :3] = _axis_angle(axis, values[name])
                     T = T @ J
-                elif kind == "prismatic" and name in self.index:
+                elif kind == "prismatic" and name in values:
                     J = np.eye(4)
-                    J[:3, 3] = np.asarray(axis) * float(qpos[self.index[name]])
+                    J[:3, 3] = np.asarray(axis) * values[name]
                     T = T @ J
                 out[child] = T
                 stack.append(child)
@@ -257,10 +268,9 @@ class SapienBackend:
         import sapien
         from mani_skill.utils.structs.pose import Pose
         torch, u, tr = self.torch, self.u, self.traj
-        q = torch.zeros(1, u.agent.robot.max_dof)
         qpos = torch.as_tensor(tr.qpos[t], dtype=torch.float32).clone()
         qpos[:6] = 0.0  # the recorded wrist pose already places the hand frame
-        q[:, u._qidx] = qpos
+        q = u.articulation_qpos(qpos[None])
         u.agent.robot.set_root_pose(Pose.create(torch.as_tensor(tr.wrist_pose[t], dtype=torch.float32)[None]))
         u.agent.robot.set_qpos(q)
         u.obj.set_pose(Pose.create(torch.as_tensor(tr.object_pose[t], dtype=torch.float32)[None]))

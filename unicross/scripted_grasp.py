@@ -29,13 +29,9 @@ PHASES = dict(descend=14, close=14, settle=6)
 
 
 def closing_delta(hand_spec) -> torch.Tensor:
-    """Per-finger-joint closing increment: flex every joint but the first of each finger
-    (abduction / thumb rotation) by 0.7 rad."""
-    delta = []
-    for j in hand_spec.finger_joints:
-        finger = next(f for f, js in hand_spec.fingers.items() if j in js)
-        delta.append(0.0 if hand_spec.fingers[finger].index(j) == 0 else 0.7)
-    return torch.tensor(delta)
+    """Per-finger-joint closing increment (the hand description's ``closing_delta``; by default
+    every joint but the first of each finger is flexed by 0.7 rad)."""
+    return torch.from_numpy(hand_spec.closing_deltas())
 
 
 class ScriptedGrasp:
