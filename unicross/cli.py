@@ -50,6 +50,7 @@ def _cmd_hands(args) -> int:
 
 
 def _cmd_grasps(args) -> int:
+    import torch
     from unicross.grasps import GraspSet
     from unicross.objects import get_object_set
     from unicross.robots.hand import load_hand
@@ -66,18 +67,24 @@ def _cmd_grasps(args) -> int:
         gs, stats = expert_grasps(args.expert, objs, args.per_object, seed=args.seed)
     else:
         gs, stats = synthesize(args.hand, objs, args.per_object, seed=args.seed)
+    held = hold_test(args.hand, gs, objs, seconds=2.0, seed=args.seed) if args.hold_test else []
+    found = len(gs)
+    if held and not args.keep_all:  # the dataset keeps the grasps that hold
+        gs = GraspSet(gs.hand, gs.object_names, gs.data[torch.tensor(held)], gs.source)
     if args.append and out.exists():
         gs = GraspSet.merge([GraspSet.load(out), gs])
     gs.save(out)
     took = time.time() - t0
-    held = hold_test(args.hand, gs, objs, seconds=2.0, seed=args.seed) if args.hold_test else []
-    summary = dict(out=str(out), hand=args.hand, objects=args.objects, num_objects=len(objs),
-                   grasps=len(gs), synthesis_success_rate=round(stats["success_rate"], 4),
+    from unicross.rl.ppo import git_commit
+    summary = dict(produced_by="unicross " + " ".join(sys.argv[1:]) if sys.argv[1:2] == ["grasps"] else None,
+                   commit=git_commit(), out=str(out), hand=args.hand, objects=args.objects, num_objects=len(objs),
+                   grasps=len(gs), found=found, synthesis_success_rate=round(stats["success_rate"], 4),
                    hold_2s_rate=round(sum(held) / len(held), 4) if held else None,
+                   kept=("all" if args.keep_all or not held else "holding"),
                    per_object=gs.counts(), seconds=round(took, 1))
-    print(f"wrote {len(gs)} grasps of {len(objs)} objects to {out} in {took:.0f}s; "
-          f"{'expert' if args.expert else 'scripted'} success {stats['success_rate']:.1%}"
-          + (f"; restored grasps holding for 2 s: {sum(held)}/{len(held)} = {sum(held) / len(held):.1%}" if held else ""))
+    print(f"{'expert' if args.expert else 'scripted'} success {stats['success_rate']:.1%}, {found} grasps"
+          + (f"; restored grasps holding for 2 s: {sum(held)}/{len(held)} = {sum(held) / len(held):.1%}" if held else "")
+          + f"; wrote {len(gs)} grasps ({summary['kept']}) of {len(objs)} objects to {out} in {took:.0f}s")
     short = [n for n, c in gs.counts().items() if c < args.per_object]
     if short:
         print(f"{len(short)} object(s) got fewer than {args.per_object} grasps, e.g. {short[:3]}")
@@ -285,6 +292,8 @@ def main(argv=None) -> int:
     s.add_argument("--out", required=True)
     s.add_argument("--seed", type=int, default=0)
     s.add_argument("--append", action="store_true", help="merge into an existing dataset at --out")
+    s.add_argument("--keep-all", action="store_true",
+                   help="keep grasps that fail the 2 s hold test too (default: keep those that hold)")
     s.add_argument("--no-hold-test", dest="hold_test", action="store_false",
                    help="skip restoring every grasp and checking it holds for 2 s")
     s.set_defaults(fn=_cmd_grasps)

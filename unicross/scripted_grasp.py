@@ -131,10 +131,11 @@ def grasp_state(u, e: int, object_id: int) -> dict:
 def hold_test(hand: str, grasps: GraspSet, objects: Sequence[ObjectSpec], seconds: float = 2.0,
               seed: int = 0, randomize: bool = False):
     """Restore each grasp in UniCross-Relocate-v1 with the final pose equal to the start (the wrist
-    holds still), keep the fingers at their recorded targets for ``seconds`` and report, per grasp,
+    holds still), keep the fingers at their recorded targets for ``seconds`` and report, per grasp
+    (a list aligned with the dataset's rows; rows of objects not in ``objects`` count as not held),
     whether the object stayed in the hand (never dropped)."""
     import unicross  # noqa: F401
-    held = []
+    held = [False] * len(grasps)
     by_name = {o.name: o for o in objects}
     for oi, name in enumerate(grasps.object_names):
         mask = grasps.data["object_id"] == oi
@@ -146,12 +147,13 @@ def hold_test(hand: str, grasps: GraspSet, objects: Sequence[ObjectSpec], second
                        hand=hand, objects=[by_name[name]], randomize=randomize, grasp_dataset=sub,
                        config=dict(relocate_target=dict(xy=0.0, z=[0.0, 0.0], rpy=0.0)))
         u = env.unwrapped
-        for k in range(len(sub)):
+        for k, row in enumerate(torch.nonzero(mask).flatten().tolist()):
+            u.grasps = GraspSet(hand, [name], sub.data[k:k + 1], grasps.source)  # exactly this grasp
             u.reset(seed=seed + k)
             zero = torch.zeros(1, u.hand_spec.dof)
             info = None
             for _ in range(int(round(seconds / u.control_dt))):
                 _, _, _, _, info = u.step(zero)
-            held.append(bool((~info["ever_dropped"]).item()))
+            held[row] = bool((~info["ever_dropped"]).item())
         env.close()
     return held
