@@ -10,7 +10,7 @@ reported as steps/s and as a ratio.
 A second table compares the physics settings that decide speed (hand self-collision, contact
 offset) on a holding scene: bare physics control steps/s for each combination.
 
-    python benchmarks/env_throughput.py [--steps 300] [--json out.json]
+    python benchmarks/env_throughput.py [--hand allegro] [--steps 300] [--json out.json] [--no-settings]
 """
 from __future__ import annotations
 
@@ -33,8 +33,8 @@ TASKS = [("UniCross-Grasp-v1", {}), ("UniCross-Relocate-v1", {}), ("UniCross-Rot
          ("UniCross-Translate-v1", {"direction": "z+"}), ("UniCross-MultiSkill-v1", {})]
 
 
-def _holding_env(task, kw, grasps, objects, **extra):
-    env = gym.make(task, obs_mode="state", sim_backend="physx_cpu", render_backend="none", objects=objects,
+def _holding_env(task, kw, grasps, objects, hand="allegro", **extra):
+    env = gym.make(task, obs_mode="state", sim_backend="physx_cpu", render_backend="none", objects=objects, hand=hand,
                    grasp_dataset=grasps, randomize=False, config=dict(grasp=dict(lift_after=None)), **kw, **extra)
     u = env.unwrapped
     u.reset(seed=0)
@@ -59,9 +59,9 @@ def _time_env(u, steps, seed=0):
         contacts += info["num_contacts"]
     rate = steps / (time.perf_counter() - t)
     art = u.agent.robot._objs[0]
-    order = u._qidx.tolist()  # hand-spec order -> articulation joint order
-    joints = [art.active_joints[i] for i in order]
-    return rate, [c[0].tolist() for c in commands], joints, float(contacts.item()) / steps
+    joints = [art.active_joints[i] for i in u._drive_idx.tolist()]  # actuated joints, then mimic followers
+    targets = [torch.cat([c, u._follow(c)], dim=-1)[0].tolist() for c in commands]
+    return rate, targets, joints, float(contacts.item()) / steps
 
 
 def _time_physics(u, commands, joints):
@@ -80,13 +80,18 @@ def main():
     p = argparse.ArgumentParser()
     p.add_argument("--steps", type=int, default=300)
     p.add_argument("--json", default=None)
+    p.add_argument("--hand", default="allegro")
+    p.add_argument("--no-settings", dest="settings", action="store_false", help="skip the physics-settings table")
     args = p.parse_args()
     torch.set_num_threads(1)
     objects = get_object_set("train", limit=1)
-    gs, _ = synthesize("allegro", objects, per_object=1, seed=0, progress=False)
+    gs, _ = synthesize(args.hand, objects, per_object=1, seed=0, progress=False)
+    have = {n for n, c in gs.counts().items() if c}
+    objects = [o for o in objects if o.name in have]  # in-hand tasks start from a grasp of each object
+    print(f"hand {args.hand}: {len(objects)} objects with a scripted grasp")
     rows = []
     for task, kw in TASKS:
-        env, u = _holding_env(task, kw, gs, objects)
+        env, u = _holding_env(task, kw, gs, objects, hand=args.hand)
         state = u.get_state_dict()
         env_rates, phys_rates = [], []
         for _ in range(3):  # interleave to share machine noise
@@ -103,23 +108,23 @@ def main():
     for r in rows:
         print(f"{r['task']:28s} {r['env_steps_per_s']:12.0f} {r['bare_physics_steps_per_s']:13.0f} {r['ratio']:6.2f} {r['contacts']:17.1f}")
     settings = []
-    for self_collision in (True, False):
-        for offset in (0.02, 0.002):
-            env, u = _holding_env("UniCross-Relocate-v1", {}, gs, objects,
-                                  hand_overrides=dict(self_collision=self_collision),
-                                  sim_config=dict(scene_config=dict(contact_offset=offset)))
-            state = u.get_state_dict()
-            _, commands, joints, _ = _time_env(u, args.steps)
-            rates = []
-            for _ in range(2):
-                u.set_state_dict(state)
-                rates.append(_time_physics(u, commands, joints))
-            settings.append(dict(self_collision=self_collision, contact_offset=offset,
-                                 bare_physics_steps_per_s=round(max(rates), 1)))
-            env.close()
-    base = settings[0]["bare_physics_steps_per_s"]
-    print("\nphysics settings (relocate scene, hand holding the object), bare physics control steps/s:")
+    for self_collision, offset in ([(True, 0.02), (True, 0.002), (False, 0.02), (False, 0.002)] if args.settings else []):
+        env, u = _holding_env("UniCross-Relocate-v1", {}, gs, objects, hand=args.hand,
+                              hand_overrides=dict(self_collision=self_collision),
+                              sim_config=dict(scene_config=dict(contact_offset=offset)))
+        state = u.get_state_dict()
+        _, commands, joints, _ = _time_env(u, args.steps)
+        rates = []
+        for _ in range(2):
+            u.set_state_dict(state)
+            rates.append(_time_physics(u, commands, joints))
+        settings.append(dict(self_collision=self_collision, contact_offset=offset,
+                             bare_physics_steps_per_s=round(max(rates), 1)))
+        env.close()
+    if settings:
+        print("\nphysics settings (relocate scene, hand holding the object), bare physics control steps/s:")
     for s in settings:
+        base = settings[0]["bare_physics_steps_per_s"]
         print(f"  self_collision={str(s['self_collision']):5s} contact_offset={s['contact_offset']:<6} "
               f"{s['bare_physics_steps_per_s']:8.0f}  ({s['bare_physics_steps_per_s'] / base:.2f}x the package defaults)")
     if args.json:
