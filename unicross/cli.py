@@ -55,7 +55,9 @@ def _cmd_grasps(args) -> int:
     from unicross.objects import get_object_set
     from unicross.robots.hand import load_hand
     from unicross.scripted_grasp import hold_test, synthesize
+    from unicross.rl.ppo import git_commit
     load_hand(args.hand)  # validates
+    commit = git_commit()  # the code that makes the grasps (HEAD may move while they are made)
     objs = get_object_set(args.objects, limit=args.limit)
     out = Path(args.out)
     t0 = time.time()
@@ -75,9 +77,8 @@ def _cmd_grasps(args) -> int:
         gs = GraspSet.merge([GraspSet.load(out), gs])
     gs.save(out)
     took = time.time() - t0
-    from unicross.rl.ppo import git_commit
     summary = dict(produced_by="unicross " + " ".join(sys.argv[1:]) if sys.argv[1:2] == ["grasps"] else None,
-                   commit=git_commit(), out=str(out), hand=args.hand, objects=args.objects, num_objects=len(objs),
+                   commit=commit, out=str(out), hand=args.hand, objects=args.objects, num_objects=len(objs),
                    grasps=len(gs), found=found, synthesis_success_rate=round(stats["success_rate"], 4),
                    hold_2s_rate=round(sum(held) / len(held), 4) if held else None,
                    kept=("all" if args.keep_all or not held else "holding"),

@@ -304,9 +304,16 @@ def _label(img: np.ndarray, text: str) -> np.ndarray:
 def make_backend(traj: Trajectory, width: int, height: int, renderer: str = "auto"):
     if renderer not in ("auto", "pyrender", "sapien"):
         raise ValueError(f"unknown renderer {renderer!r}; valid: auto, pyrender, sapien")
-    if renderer == "sapien" or (renderer == "auto" and _sapien_can_render()):
+    if renderer == "sapien" or (renderer == "auto" and _sapien_can_render() and _has_visual_meshes(traj.meta["hand"])):
         return SapienBackend(traj, width, height)
     return PyrenderBackend(traj, width, height)
+
+
+def _has_visual_meshes(hand: str) -> bool:
+    """Procedural hands have collision primitives only; SAPIEN would draw them invisible, pyrender
+    draws their capsules."""
+    from unicross.robots.hand import PROCEDURAL, load_hand
+    return not load_hand(hand).urdf.startswith(PROCEDURAL)
 
 
 def _sapien_can_render() -> bool:
