@@ -54,8 +54,14 @@ def test_every_task_id_steps_within_joint_limits(hand):
         for _ in range(4):
             obs, reward, *_ = env.step(torch.rand(1, spec.dof, generator=g) * 2 - 1)
             assert torch.isfinite(obs).all() and torch.isfinite(reward).all(), task
+            # drive targets (actuated and coupled joints) never leave the limits ...
+            targets = torch.cat([u.command, u._follow(u.command)], dim=-1)[0]
+            tl = lim[u._drive_idx]
+            assert torch.all(targets >= tl[:, 0] - 1e-6) and torch.all(targets <= tl[:, 1] + 1e-6), task
+            # ... and joints stay within them up to what PhysX gives way under hard contacts (the
+            # random wrist actions press the held object into the fingers with the stiff wrist PD)
             q = robot.get_qpos()[0]
-            assert torch.all(q >= lim[:, 0] - 0.03) and torch.all(q <= lim[:, 1] + 0.03), (task, q, lim)
+            assert torch.all(q >= lim[:, 0] - 0.06) and torch.all(q <= lim[:, 1] + 0.06), (task, q, lim)
         env.close()
 
 
