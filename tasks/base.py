@@ -321,6 +321,7 @@ class UniCrossEnv(BaseEnv):
         # ---- in-hand start (relocate / rotate / translate): a grasp state from the dataset
         hand_p, hand_q, obj_p, obj_q = hand_p_grasp, hand_q_grasp, obj_p_table, obj_q_table
         fq, ft = fq_grasp, fq_grasp
+        mq = None  # recorded coupled-joint positions of a restored grasp
         if self.grasps is not None:
             gs = self.grasps.sample(self.obj_index[env_idx], self.object_names, g)
             random_q = _random_quaternion(b, g, dev)
@@ -342,10 +343,14 @@ class UniCrossEnv(BaseEnv):
             obj_q = torch.where(is_grasp, obj_q, oq)
             fq = torch.where(is_grasp, fq, gs["finger_qpos"])
             ft = torch.where(is_grasp, ft, gs["finger_target"])
+            if "mimic_qpos" in gs.keys() and gs["mimic_qpos"].shape[-1] == len(self._midx) > 0:
+                mq = (is_grasp, gs["mimic_qpos"])
         # ---- apply to the simulation
         qpos = torch.zeros(b, spec.dof, device=dev)
         qpos[:, 6:] = fq
         art_q = self.articulation_qpos(qpos)
+        if mq is not None:  # coupled joints where they were, not where the coupling would put them
+            art_q[:, self._midx] = torch.where(mq[0], art_q[:, self._midx], mq[1])
         self.agent.robot.set_qpos(art_q)
         self.agent.robot.set_qvel(torch.zeros_like(art_q))
         self.agent.robot.set_root_pose(Pose.create_from_pq(hand_p, hand_q))

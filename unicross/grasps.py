@@ -10,6 +10,8 @@ One file (``torch.save``) holds::
         wrist_pose         [B, 7]  world pose of the hand frame (p, q wxyz) when recorded
         object_pose_hand   [B, 7]  object pose in the hand frame
         object_id          [B]     index into object_names
+        mimic_qpos         [B, M]  (optional) coupled joints' positions, the hand's ``mimic`` order;
+                                   without it a restore puts them where the coupling says
     }
 
 The scripted synthesiser (:mod:`unicross.scripted_grasp`) and, later, the grasp expert write this
@@ -31,8 +33,11 @@ FORMAT = "unicross-grasps/1"
 KEYS = ("finger_qpos", "finger_target", "wrist_pose", "object_pose_hand", "object_id")
 
 
+OPTIONAL_KEYS = ("mimic_qpos",)
+
+
 def empty_rows() -> Dict[str, list]:
-    return {k: [] for k in KEYS}
+    return {k: [] for k in KEYS + OPTIONAL_KEYS}
 
 
 def from_rows(hand: str, object_names: Sequence[str], rows: Dict[str, list], tried: Dict[str, int],
@@ -40,7 +45,7 @@ def from_rows(hand: str, object_names: Sequence[str], rows: Dict[str, list], tri
     """(GraspSet, stats) from per-grasp rows collected by a grasp builder (scripted or expert)."""
     if not rows["object_id"]:
         raise RuntimeError(f"the {source} grasp builder produced no grasp")
-    data = TensorDict({k: torch.stack(v) for k, v in rows.items()}, batch_size=[len(rows["object_id"])])
+    data = TensorDict({k: torch.stack(v) for k, v in rows.items() if v}, batch_size=[len(rows["object_id"])])
     stats = dict(tried=tried, kept=kept, success_rate=sum(kept.values()) / max(1, sum(tried.values())))
     return GraspSet(hand, list(object_names), data, source=source), stats
 
@@ -102,6 +107,8 @@ class GraspSet:
             d = s.data.clone()
             d["object_id"] = torch.tensor(remap)[d["object_id"]]
             parts.append(d)
+        common = set.intersection(*(set(p.keys()) for p in parts))  # optional keys only where all have them
+        parts = [p.select(*sorted(common)) for p in parts]
         return GraspSet(sets[0].hand, names, torch.cat(parts), sets[0].source)
 
     def sample(self, env_object: torch.Tensor, env_object_names: Sequence[str],

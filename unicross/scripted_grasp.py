@@ -121,8 +121,10 @@ def synthesize(hand: str, objects: Sequence[ObjectSpec], per_object: int, seed: 
 def grasp_state(u, e: int, object_id: int) -> dict:
     """The grasp-dataset row of env ``e`` of the unwrapped task ``u`` (copies, on the CPU)."""
     pos, quat = u.sensor.poses()
-    q = u.agent.robot.get_qpos()[:, u._qidx]
+    full = u.agent.robot.get_qpos()
+    q = full[:, u._qidx]
     return dict(finger_qpos=q[e, 6:].cpu().clone(), finger_target=u.command[e, 6:].cpu().clone(),
+                mimic_qpos=full[e, u._midx].cpu().clone(),
                 wrist_pose=torch.cat([pos[e, 0], quat[e, 0]]).cpu().clone(),
                 object_pose_hand=torch.cat([u.cur_rel.x_oh[e], u.cur_rel.q_oh[e]]).cpu().clone(),
                 object_id=torch.tensor(object_id))
