@@ -47,6 +47,21 @@ def test_tiny_ppo_updates_weights_with_finite_losses(tmp_path):
     t.close()
 
 
+def test_training_needs_no_edit_for_another_hand(tmp_path):
+    """The same trainer, networks and checkpoint for the 28-DoF Sharpa Wave (in-hand rotate,
+    starting from its shipped grasps): sizes follow from the hand description."""
+    from unicross.robots.hand import load_hand
+    spec = load_hand("sharpa_wave")
+    t = PPOTrainer(tmp_path / "run", "rotate", axis="z+", hand="sharpa_wave", overrides=TINY, progress=False)
+    assert t.n_act == spec.dof == 28
+    before = [p.detach().clone() for p in t.policy.parameters()]
+    t.train(max_iterations=1)
+    assert any(not torch.equal(a, b) for a, b in zip(before, t.policy.parameters()))
+    t.close()
+    ck = torch.load(tmp_path / "run" / "checkpoint.pt", weights_only=False)
+    assert ck["hand"] == "sharpa_wave"
+
+
 def test_resume_continues_with_identical_optimiser_state(tmp_path):
     run = tmp_path / "run"
     t = PPOTrainer(run, "grasp", overrides=TINY, progress=False)
