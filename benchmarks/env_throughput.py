@@ -91,7 +91,11 @@ def main():
     print(f"hand {args.hand}: {len(objects)} objects with a scripted grasp")
     rows = []
     for task, kw in TASKS:
-        env, u = _holding_env(task, kw, gs, objects, hand=args.hand)
+        try:
+            env, u = _holding_env(task, kw, gs, objects, hand=args.hand)
+        except ValueError as e:  # e.g. no elongated grasp for translate
+            print(f"{task}: skipped ({e})")
+            continue
         state = u.get_state_dict()
         env_rates, phys_rates = [], []
         for _ in range(3):  # interleave to share machine noise
