@@ -31,6 +31,20 @@ def test_scripted_relocation_baseline_table(grasp_file, tiny_objects):
     assert "Relocate SR" in E.markdown_table({"baseline": {"relocate": s}})
 
 
+def test_objects_without_grasps_are_left_out_or_refused(grasp_file, tiny_objects):
+    from unicross.grasps import GraspSet
+    gs = GraspSet.load(grasp_file)
+    wrappable = [o for o in tiny_objects if o.category == "wrappable"]
+    keep = gs.data["object_id"] == gs.object_names.index(wrappable[0].name)
+    one = GraspSet(gs.hand, gs.object_names, gs.data[keep], gs.source)  # grasps of one object only
+    trials = E.run_protocol("relocate", E.zero_policy, wrappable, trials_per_object=1,
+                            grasp_dataset=one, progress=False)
+    assert [t["object"] for t in trials] == [wrappable[0].name]
+    with pytest.raises(ValueError, match="no grasp of any"):
+        E.run_protocol("relocate", E.zero_policy, wrappable[1:], trials_per_object=1, grasp_dataset=one,
+                       progress=False)
+
+
 def test_disturbance_and_original_settings(grasp_file, tiny_objects):
     obj = [o for o in tiny_objects if o.category == "wrappable"][0]
     env = E._env_for("rotate", "z+", obj, "allegro", disturb=True, randomize=False, grasp_dataset=grasp_file,

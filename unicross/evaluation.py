@@ -22,6 +22,7 @@ paper's naive relocation baseline). Same seed and policy give identical results.
 """
 from __future__ import annotations
 
+import logging
 from typing import Callable, Dict, List, Optional, Sequence
 
 import gymnasium as gym
@@ -32,6 +33,8 @@ from unicross import formulation as F
 from unicross import metrics as M
 from unicross.geometry import pose_inv, pose_mul, quat_to_euler_xyz
 from unicross.objects import ObjectSpec
+
+logger = logging.getLogger(__name__)
 
 PROTOCOLS = ("grasp", "relocate", "rotate", "translate")
 STEPS = dict(grasp=75, relocate=75, rotate=400, translate=50)
@@ -151,6 +154,18 @@ def run_protocol(protocol: str, policy: PolicyFn, objects: Sequence[ObjectSpec],
     objs = [o for o in objects if cat is None or o.category == cat]
     if not objs:
         raise ValueError(f"no {cat} object in the set for protocol {protocol!r}")
+    if protocol != "grasp":  # in-hand protocols start from grasps: objects without one cannot be evaluated
+        from unicross.grasps import GraspSet, default_grasp_path
+        gs = grasp_dataset if isinstance(grasp_dataset, GraspSet) else \
+            GraspSet.load(grasp_dataset or default_grasp_path(hand))
+        have = {n for n, c in gs.counts().items() if c > 0}
+        lacking = [o.name for o in objs if o.name not in have]
+        if len(lacking) == len(objs):
+            raise ValueError(f"the grasp dataset has no grasp of any {protocol} object ({lacking[:3]}...); "
+                             f"build them with `unicross grasps --hand {hand} --objects <set>`")
+        if lacking:
+            logger.warning(f"{protocol}: {len(lacking)} object(s) without a grasp are not evaluated: {lacking}")
+            objs = [o for o in objs if o.name in have]
     steps = STEPS[protocol]
     trials = []
     total = len(objs) * len(AXES[protocol]) * trials_per_object
