@@ -42,10 +42,12 @@ def _cmd_info(args) -> int:
 
 def _cmd_hands(args) -> int:
     from unicross.robots.hand import available_hands, load_hand
-    print(f"{'hand':12s} {'DoF':>4s} {'wrist':>6s} {'fingers':>8s} {'contact links':>14s}  urdf")
+    print(f"{'hand':12s} {'DoF':>4s} {'wrist':>6s} {'fingers':>8s} {'coupled':>8s} {'contact links':>14s} "
+          f"{'objects':>8s}  urdf")
     for name in available_hands():
         s = load_hand(name)
-        print(f"{name:12s} {s.dof:4d} {6:6d} {len(s.finger_joints):8d} {len(s.contact_links):14d}  {s.urdf}")
+        print(f"{name:12s} {s.dof:4d} {6:6d} {len(s.finger_joints):8d} {len(s.mimic):8d} {len(s.contact_links):14d} "
+              f"{'x' + format(s.object_scale, 'g'):>8s}  {s.urdf}")
     return 0
 
 
