@@ -70,7 +70,7 @@ def _cmd_grasps(args) -> int:
         args.hand = ck["hand"]
         gs, stats = expert_grasps(args.expert, objs, args.per_object, seed=args.seed)
     else:
-        gs, stats = synthesize(args.hand, objs, args.per_object, seed=args.seed)
+        gs, stats = synthesize(args.hand, objs, args.per_object, seed=args.seed, randomize=args.randomize)
     held = hold_test(args.hand, gs, objs, seconds=2.0, seed=args.seed) if args.hold_test else []
     found = len(gs)
     if held and not args.keep_all:  # the dataset keeps the grasps that hold
@@ -295,6 +295,8 @@ def main(argv=None) -> int:
     s.add_argument("--out", required=True)
     s.add_argument("--seed", type=int, default=0)
     s.add_argument("--append", action="store_true", help="merge into an existing dataset at --out")
+    s.add_argument("--no-randomize", dest="randomize", action="store_false",
+                   help="synthesise at nominal mass/friction (default: randomised, as in training)")
     s.add_argument("--keep-all", action="store_true",
                    help="keep grasps that fail the 2 s hold test too (default: keep those that hold)")
     s.add_argument("--no-hold-test", dest="hold_test", action="store_false",
