@@ -127,8 +127,8 @@ def main():
         env.close()
     if settings:
         print("\nphysics settings (relocate scene, hand holding the object), bare physics control steps/s:")
-    for s in settings:
         base = settings[0]["bare_physics_steps_per_s"]
+    for s in settings:
         print(f"  self_collision={str(s['self_collision']):5s} contact_offset={s['contact_offset']:<6} "
               f"{s['bare_physics_steps_per_s']:8.0f}  ({s['bare_physics_steps_per_s'] / base:.2f}x the package defaults)")
     if args.json:

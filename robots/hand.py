@@ -171,9 +171,8 @@ class HandSpec:
             if unknown:
                 raise ValueError(f"hand {self.name!r}: closing_delta names unknown joints {sorted(unknown)}")
             return np.array([float(self.closing_delta.get(j, 0.0)) for j in self.finger_joints], np.float32)
-        return np.array([0.0 if self.fingers[f].index(j) == 0 else 0.7
-                         for j in self.finger_joints
-                         for f in [next(f for f, js in self.fingers.items() if j in js)]], np.float32)
+        first = {js[0] for js in self.fingers.values()}
+        return np.array([0.0 if j in first else 0.7 for j in self.finger_joints], np.float32)
 
     def action_scales(self) -> np.ndarray:
         s = self.action_scale
@@ -382,6 +381,7 @@ def register_hand_agent(spec: HandSpec) -> type:
         uid = spec.uid
         disable_self_collisions = not spec.self_collision
         hand_spec = spec
+        finger_gains = gains  # (stiffness, damping, force limit) per finger joint and follower
 
         def __init__(self, *args, **kwargs):
             self.urdf_path = str(urdf_path)

@@ -37,7 +37,7 @@ from unicross.geometry import (
 from unicross.grasps import GraspSet, default_grasp_path
 from unicross.objects import resolve_objects
 from unicross.rewards import RewardTerms
-from unicross.robots.hand import HAND_FRAME_LINK, HandSpec, finger_drive_gains, load_hand, register_hand_agent
+from unicross.robots.hand import HAND_FRAME_LINK, HandSpec, load_hand, register_hand_agent
 from unicross.sensing import HandObjectSensor
 
 CATEGORY_ID = {"wrappable": 0, "elongated": 1}
@@ -216,7 +216,8 @@ class UniCrossEnv(BaseEnv):
         spec, robot, dev = self.hand_spec, self.agent.robot, self.device
         names = [j.name for j in robot.active_joints]
         self._qidx = torch.tensor([names.index(j) for j in spec.joint_names], device=dev)
-        lim = robot.get_qlimits()[0].to(dev)[self._qidx]
+        all_lim = robot.get_qlimits()[0].to(dev)
+        lim = all_lim[self._qidx]
         self.q_lower, self.q_upper = lim[:, 0].clone(), lim[:, 1].clone()
         self.action_scale = torch.tensor(spec.action_scales(), device=dev)
         links = {l.name: l for l in robot.links}
@@ -230,7 +231,7 @@ class UniCrossEnv(BaseEnv):
             probe.append(np.mean([s.local_pose.p for s in shapes], axis=0) if shapes else np.zeros(3))
         self.link_probe = torch.tensor(np.array(probe), dtype=torch.float32, device=dev)
         self.sensor = HandObjectSensor(self.scene, links[HAND_FRAME_LINK], self.contact_links, self.obj)
-        gains = finger_drive_gains(spec, self.agent.urdf_path)
+        gains = self.agent.finger_gains
         self._finger_pd = tuple(torch.tensor([gains[j][k] for j in spec.finger_joints], device=dev)
                                 for k in range(3))
         # mimic followers: drive target = multiplier * target(leader) + offset, within limits
@@ -240,7 +241,6 @@ class UniCrossEnv(BaseEnv):
                                        dtype=torch.long, device=dev)
         self._mimic_k = torch.tensor([k for *_, k, _ in mimic], device=dev)
         self._mimic_o = torch.tensor([o for *_, o in mimic], device=dev)
-        all_lim = robot.get_qlimits()[0].to(dev)
         self._mimic_lim = all_lim[self._midx]
         self._drive_idx = torch.cat([self._qidx, self._midx])
         self.episode_length = torch.tensor([self.cfg["episode_length"][F.mode_skill(m)] for m in F.MODES], device=dev)

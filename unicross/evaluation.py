@@ -158,6 +158,7 @@ def run_protocol(protocol: str, policy: PolicyFn, objects: Sequence[ObjectSpec],
         from unicross.grasps import GraspSet, default_grasp_path
         gs = grasp_dataset if isinstance(grasp_dataset, GraspSet) else \
             GraspSet.load(grasp_dataset or default_grasp_path(hand))
+        grasp_dataset = gs  # loaded once for all the protocol's envs
         have = {n for n, c in gs.counts().items() if c > 0}
         lacking = [o.name for o in objs if o.name not in have]
         if len(lacking) == len(objs):
