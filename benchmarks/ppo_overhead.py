@@ -30,7 +30,7 @@ def main():
     run = tempfile.mkdtemp()
     t = PPOTrainer(os.path.join(run, "r"), "grasp", progress=False,
                    overrides=dict(env=dict(num_envs=args.num_envs, reconfiguration_freq=0),
-                                  collector=dict(total_frames=10 ** 9), logging=dict(eval_episodes=0, checkpoint_every=10 ** 6)))
+                                  collector=dict(total_frames=10 ** 9), logging=dict(eval_trials=0, checkpoint_every=10 ** 6)))
     frames = t.frames_per_batch * args.iterations
     steps = frames // t.batch_envs
     t.env.rollout(8, break_when_any_done=False)  # warm up workers

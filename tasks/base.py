@@ -36,13 +36,30 @@ from unicross.geometry import (
 )
 from unicross.grasps import GraspSet, default_grasp_path
 from unicross.objects import resolve_objects
-from unicross.rewards import RewardTerms
+from unicross.rewards import TERMS as REWARD_TERMS, RewardTerms
 from unicross.robots.hand import HAND_FRAME_LINK, HandSpec, load_hand, register_hand_agent
 from unicross.sensing import HandObjectSensor
 
 CATEGORY_ID = {"wrappable": 0, "elongated": 1}
 MODE_CATEGORIES = {"grasp": ("wrappable", "elongated"), "relocate": ("wrappable", "elongated"),
                    "rotate": ("wrappable",), "translate": ("elongated",)}
+
+
+def _tensors(obs):
+    """The tensors of an observation (a tensor or nested dicts of tensors)."""
+    if torch.is_tensor(obs):
+        yield obs
+    elif isinstance(obs, dict):
+        for v in obs.values():
+            yield from _tensors(v)
+
+
+def _map_tensors(obs, fn):
+    if torch.is_tensor(obs):
+        return fn(obs)
+    if isinstance(obs, dict):
+        return {k: _map_tensors(v, fn) for k, v in obs.items()}
+    return obs
 
 
 def _random_quaternion(n: int, gen: torch.Generator, device) -> torch.Tensor:
@@ -71,6 +88,7 @@ class UniCrossEnv(BaseEnv):
     SUPPORTED_REWARD_MODES = ("dense", "sparse", "none")
     DEFAULT_OBJECTS = "train"
     DEFAULT_MODES: Sequence[str] = F.MODES
+    _seeded_reset = True  # until the first reset says otherwise
 
     def __init__(self, *args, hand: str = "allegro", hand_overrides: Optional[dict] = None,
                  objects=None, object_limit: Optional[int] = None,
@@ -249,6 +267,11 @@ class UniCrossEnv(BaseEnv):
         self._speed_cap = torch.tensor([self.cfg["motion"]["omega_max"] if F.mode_skill(m) == "rotate"
                                         else self.cfg["motion"]["v_max"] for m in F.MODES], device=dev)
         self._world_up = torch.tensor([0.0, 0.0, 1.0], device=dev)
+        rc = self.cfg["randomization"]
+        wp, wr = rc["wrist_obs_noise"]
+        self._obs_noise_scale = torch.tensor([wp] * 3 + [wr] * 3 + [rc["joint_obs_noise"]] * (spec.dof - 6),
+                                             device=dev) * float(rc["enabled"])
+        self._obs_noise_on = bool(self._obs_noise_scale.abs().sum() > 0)
         if not self.gpu_sim_enabled:  # raw PhysX joints in hand-spec order (CPU: one env)
             art = robot._objs[0]
             self._cpu_joints = [art.active_joints[i] for i in self._drive_idx.tolist()]
@@ -288,7 +311,9 @@ class UniCrossEnv(BaseEnv):
     def _initialize_episode(self, env_idx: torch.Tensor, options: dict):
         dev, spec = self.device, self.hand_spec
         b = len(env_idx)
-        if options.get("seed_generator", True) and self._episode_seed is not None:
+        # a seeded reset replays its episode exactly; an unseeded one continues the task generator,
+        # so every episode draws a new start, perturbation and noise sequence
+        if self._seeded_reset and options.get("seed_generator", True):
             self._gen.manual_seed(int(self._episode_seed[0]))
         g = self._gen
         mode = self.mode[env_idx]
@@ -392,11 +417,19 @@ class UniCrossEnv(BaseEnv):
             direction = torch.nn.functional.normalize(torch.randn(b, 3, generator=g, device=dev), dim=-1)
             mag = torch.rand(b, generator=g, device=dev) * dmax * self.obj_mass[env_idx] * 9.81
             self.disturb[env_idx] = direction * mag[:, None]
+        self.obs_noise[env_idx] = self._draw_obs_noise(b)
         for t in (self.obj_vel_h, self.obj_angvel_h, self.hand_vel, self.hand_angvel):
             t[env_idx] = 0
         self._pending[env_idx] = True
 
+    def _draw_obs_noise(self, n: int) -> torch.Tensor:
+        """U(-1, 1) x per-joint noise scale: ``joint_obs_noise`` (rad) on finger joints,
+        ``wrist_obs_noise`` (m, rad) on the virtual wrist joints."""
+        u = torch.rand(n, self.hand_spec.dof, generator=self._gen, device=self.device) * 2 - 1
+        return u * self._obs_noise_scale
+
     def reset(self, seed=None, options=None):
+        self._seeded_reset = seed is not None
         obs, info = super().reset(seed=seed, options=options)
         # finger drive targets of a restored grasp (the controller reset set them to qpos)
         self._apply_command()
@@ -446,6 +479,16 @@ class UniCrossEnv(BaseEnv):
         obs, reward, _, _, info = super().step(None)  # drive targets are set; ManiSkill runs the substeps
         terminated = info["fail"].clone() if self.cfg["terminate_on_drop"] else torch.zeros_like(info["fail"])
         truncated = self.elapsed_steps >= self.episode_length[self.mode]
+        # a non-finite observation or reward (a physics blow-up) never reaches a learner: it is
+        # zeroed, reported as info["nonfinite"], and the env's episode ends (truncated) to be reset
+        bad = ~torch.isfinite(reward) if torch.is_tensor(reward) else torch.zeros_like(truncated)
+        for x in _tensors(obs):
+            bad = bad | ~torch.isfinite(x.reshape(self.num_envs, -1)).all(-1)
+        info["nonfinite"] = bad
+        if bool(bad.any()):
+            reward = torch.where(bad, torch.zeros_like(reward), reward)
+            obs = _map_tensors(obs, lambda x: torch.nan_to_num(x, nan=0.0, posinf=0.0, neginf=0.0))
+            truncated = truncated | bad
         return obs, reward, terminated, truncated, info
 
     def _advance_lift(self) -> torch.Tensor:
@@ -551,10 +594,8 @@ class UniCrossEnv(BaseEnv):
         self.axis = torch.where(p1, axis, self.axis)
         self.prev_rel = cur.where(pend, self.prev_rel)
         self.cur_rel = cur
-        rc = self.cfg["randomization"]
-        if rc["enabled"] and rc["joint_obs_noise"] > 0:
-            noise = (torch.rand(self.obs_noise.shape, generator=self._gen, device=self.device) * 2 - 1) * rc["joint_obs_noise"]
-            self.obs_noise = torch.where(p1, noise, self.obs_noise)
+        if self._obs_noise_on:
+            self.obs_noise = torch.where(p1, self._draw_obs_noise(self.num_envs), self.obs_noise)
         self._pending = torch.zeros_like(pend)
         # drop and success (DESIGN §6)
         dist = m["link_distance"]
@@ -585,7 +626,7 @@ class UniCrossEnv(BaseEnv):
         meas = dict(link_distance=dist, contact=contact, force_clipped=force_c, speed_along_axis=speed,
                     speed_cap=self._speed_cap[self.mode], relational=cur, reward_targets=reward_targets,
                     finger_qpos=m["qpos"][:, 6:], finger_qpos0=self.finger_q0, hand_lin_vel=self.hand_vel,
-                    hand_ang_vel=self.hand_angvel, finger_torque=m["finger_torque"], drop=drop)
+                    hand_ang_vel=self.hand_angvel, finger_torque=m["finger_torque"], drop=drop, success=success)
         terms = self.rewards(self.mode, meas)
         self._obs_parts = dict(qpos=m["qpos"], contact=contact, force=force_c, vec=m["link_vec"])
         info = dict(success=success, fail=drop, drop=drop, ever_dropped=self.ever_dropped.clone(),
@@ -616,7 +657,7 @@ class UniCrossEnv(BaseEnv):
 
     # ------------------------------------------------------------------ reward
     def compute_dense_reward(self, obs: Any, action: torch.Tensor, info: dict):
-        return sum(info[f"reward_{k}"] for k in ("contact", "motion", "track", "pose", "wrist_velocity", "energy", "drop"))
+        return sum(info[f"reward_{k}"] for k in REWARD_TERMS)
 
     def compute_normalized_dense_reward(self, obs: Any, action: torch.Tensor, info: dict):
         return self.compute_dense_reward(obs, action, info)

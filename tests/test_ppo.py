@@ -12,7 +12,7 @@ from unicross.rl.env import ManiSkillEnv
 from unicross.rl.ppo import PPOTrainer
 
 TINY = dict(env=dict(num_envs=1, object_limit=1), collector=dict(total_frames=96, horizon=16),
-            optim=dict(minibatch_size=8, mini_epochs=2), logging=dict(eval_episodes=0, checkpoint_every=1))
+            optim=dict(minibatch_size=8, mini_epochs=2), logging=dict(eval_trials=0, checkpoint_every=1))
 
 
 @pytest.mark.parametrize("env_id,kw", [("UniCross-Grasp-v1", {}), ("UniCross-Relocate-v1", {}),
@@ -125,7 +125,7 @@ def test_ablation_row_is_one_train_and_one_eval(tmp_path):
     from unicross.cli import main
     run = tmp_path / "abl"
     assert main(["train", "--skill", "grasp", "--out", str(run), "--num-envs", "1", "--total-frames", "32",
-                 "--ablation", "no_target_obs", "--set", "collector.horizon=16", "--set", "logging.eval_episodes=0",
+                 "--ablation", "no_target_obs", "--set", "collector.horizon=16", "--set", "logging.eval_trials=0",
                  "--set", "env.object_limit=1", "--set", "optim.minibatch_size=16"]) == 0
     out = tmp_path / "abl.json"
     assert main(["eval", "--policy", str(run / "checkpoint.pt"), "--protocol", "grasp", "--objects", "train-wrappable",

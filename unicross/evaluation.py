@@ -145,11 +145,17 @@ def _env_for(protocol: str, axis: Optional[str], obj: ObjectSpec, hand: str, dis
 def run_protocol(protocol: str, policy: PolicyFn, objects: Sequence[ObjectSpec], hand: str = "allegro",
                  trials_per_object: int = 25, seed: int = 0, disturb: bool = False, randomize: bool = False,
                  grasp_dataset=None, original: bool = False, progress: bool = True,
-                 videos: int = 0, video_dir=None, ablation: Optional[dict] = None) -> List[dict]:
+                 videos: int = 0, video_dir=None, ablation: Optional[dict] = None,
+                 axes: Optional[Sequence[str]] = None) -> List[dict]:
     """All trials of one protocol; returns one dict per trial. The first ``videos`` trials are
-    recorded as trajectory files (and rendered to mp4) in ``video_dir``."""
+    recorded as trajectory files (and rendered to mp4) in ``video_dir``. ``axes`` restricts
+    rotate/translate to some of the protocol's axes (default: all)."""
     if protocol not in PROTOCOLS:
         raise ValueError(f"unknown protocol {protocol!r}; valid: {list(PROTOCOLS)}")
+    bad = [a for a in (axes or []) if a not in AXES[protocol]]
+    if bad:
+        raise ValueError(f"axes {bad} are not axes of protocol {protocol!r}: {AXES[protocol]}")
+    axes = list(axes) if axes else AXES[protocol]
     cat = CATEGORY[protocol]
     objs = [o for o in objects if cat is None or o.category == cat]
     if not objs:
@@ -169,10 +175,10 @@ def run_protocol(protocol: str, policy: PolicyFn, objects: Sequence[ObjectSpec],
             objs = [o for o in objs if o.name in have]
     steps = STEPS[protocol]
     trials = []
-    total = len(objs) * len(AXES[protocol]) * trials_per_object
+    total = len(objs) * len(axes) * trials_per_object
     bar = tqdm(total=total, desc=f"eval {protocol}", disable=not progress)
     for oi, obj in enumerate(objs):
-        for axis in AXES[protocol]:
+        for axis in axes:
             env = _env_for(protocol, axis, obj, hand, disturb, randomize, grasp_dataset, original, ablation)
             u = env.unwrapped
             axis_vec = F.MODE_AXES[F.mode_index(protocol, axis) if protocol in ("rotate", "translate") else 0]

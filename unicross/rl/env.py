@@ -18,9 +18,11 @@ from tensordict import TensorDict, TensorDictBase
 from torchrl.data import Bounded, Categorical, Composite, Unbounded
 from torchrl.envs import EnvBase
 
-INFO_FLOAT = ("rotation", "translation", "relocate_pos_err", "relocate_rot_err", "reward_contact", "reward_motion",
-              "reward_track", "reward_pose", "reward_wrist_velocity", "reward_energy", "reward_drop")
-INFO_BOOL = ("success", "drop")
+from unicross.rewards import TERMS as REWARD_TERMS
+
+INFO_FLOAT = ("rotation", "translation", "relocate_pos_err", "relocate_rot_err") + \
+    tuple(f"reward_{t}" for t in REWARD_TERMS)
+INFO_BOOL = ("success", "drop", "nonfinite")
 
 
 def obs_to_td(obs: dict, device=None) -> TensorDict:

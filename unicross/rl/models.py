@@ -4,13 +4,19 @@ An MLP encoder on g (hidden [128, 64]) and a main MLP on [s^h, s^o, enc(g)] (hid
 [512, 256, 128]). The actor outputs a Gaussian mean with a learned, state-independent std; the
 value network has the same shape with one output. Inputs are normalised by running statistics
 (:class:`ObsNormalizer`), which are part of the checkpoint.
+
+Initialisation follows CleanRL/TorchRL's PPO examples: the last layer of the action mean is scaled
+by ``action_init_scale`` (0.01) with zero bias, so the untrained deterministic policy is close to
+the zero action (residual actions integrate any bias into the wrist and finger targets). The
+critic predicts returns in units of running return statistics (:class:`ValueNormalizer`); the
+value module used by GAE and inference outputs them denormalised as ``state_value``.
 """
 from __future__ import annotations
 
 from typing import Sequence
 
 import torch
-from tensordict.nn import TensorDictModule
+from tensordict.nn import TensorDictModule, TensorDictSequential
 from torch import nn
 from torchrl.modules import IndependentNormal, ProbabilisticActor, ValueOperator
 
@@ -41,11 +47,16 @@ class ObsNormalizer(nn.Module):
         self.clip = clip
 
     @torch.no_grad()
-    def update(self, batch: dict) -> None:
-        n = None
+    def update(self, batch: dict) -> int:
+        """Folds the rows of ``batch`` (dict of [..., d] tensors) into the statistics; rows with a
+        non-finite entry in any group are left out. Returns the number of rows used."""
+        rows = {k: batch[k].reshape(-1, batch[k].shape[-1]).float() for k in self.keys}
+        finite = torch.stack([torch.isfinite(x).all(-1) for x in rows.values()]).all(0)
+        n = int(finite.sum())
+        if n == 0:
+            return 0
         for k in self.keys:
-            x = batch[k].reshape(-1, batch[k].shape[-1]).float()
-            n = x.shape[0]
+            x = rows[k][finite]
             mean, var = x.mean(0), x.var(0, unbiased=False)
             m, v, c = getattr(self, f"{k}_mean"), getattr(self, f"{k}_var"), self.count
             delta = mean - m
@@ -53,6 +64,7 @@ class ObsNormalizer(nn.Module):
             m += delta * n / tot
             v.copy_((v * c + var * n + delta ** 2 * c * n / tot) / tot)
         self.count += n
+        return n
 
     def forward(self, key: str, x: torch.Tensor) -> torch.Tensor:
         m, v = getattr(self, f"{key}_mean"), getattr(self, f"{key}_var")
@@ -75,11 +87,47 @@ class UniCrossNet(nn.Module):
         return self.main(torch.cat([n("hand", hand), n("object", obj), z], dim=-1))
 
 
+class ValueNormalizer(nn.Module):
+    """Running mean/variance of the value targets (returns); the critic learns in their units."""
+
+    def __init__(self):
+        super().__init__()
+        self.register_buffer("mean", torch.zeros(()))
+        self.register_buffer("var", torch.ones(()))
+        self.register_buffer("count", torch.tensor(1e-4))
+
+    @torch.no_grad()
+    def update(self, x: torch.Tensor) -> None:
+        x = x.reshape(-1).float()
+        x = x[torch.isfinite(x)]
+        if x.numel() == 0:
+            return
+        n, mean, var = x.numel(), x.mean(), x.var(unbiased=False)
+        delta, tot = mean - self.mean, self.count + x.numel()
+        self.var.copy_((self.var * self.count + var * n + delta ** 2 * self.count * n / tot) / tot)
+        self.mean += delta * n / tot
+        self.count += n
+
+    def std(self) -> torch.Tensor:
+        return torch.sqrt(self.var + 1e-8)
+
+    def normalize(self, x: torch.Tensor) -> torch.Tensor:
+        return (x - self.mean) / self.std()
+
+    def forward(self, x_norm: torch.Tensor) -> torch.Tensor:
+        """Denormalise a prediction."""
+        return x_norm * self.std() + self.mean
+
+
 class GaussianHead(nn.Module):
-    def __init__(self, net: UniCrossNet, n_act: int, init_log_std: float = -0.5):
+    def __init__(self, net: UniCrossNet, n_act: int, init_log_std: float = -0.5, init_scale: float = 1.0):
         super().__init__()
         self.net = net
         self.log_std = nn.Parameter(torch.full((n_act,), init_log_std))
+        last = net.main[-1]
+        with torch.no_grad():  # near-zero initial action mean
+            last.weight.mul_(init_scale)
+            last.bias.zero_()
 
     def forward(self, hand, obj, goal):
         loc = self.net(hand, obj, goal)
@@ -87,15 +135,25 @@ class GaussianHead(nn.Module):
 
 
 def make_models(dims: dict, n_act: int, action_spec=None, cfg: dict | None = None):
-    """Returns (policy, value, normalizer) as TensorDict modules over keys hand/object/goal."""
+    """Returns (policy, value, normalizer) as TensorDict modules over keys hand/object/goal.
+
+    ``value`` writes ``state_value_norm`` (the critic's output, in units of the return
+    statistics ``value.value_norm``) and ``state_value`` (denormalised, for GAE); ``value.critic``
+    is the first of the two modules (what the critic loss trains)."""
     cfg = cfg or {}
     enc, main = tuple(cfg.get("encoder_hidden", (128, 64))), tuple(cfg.get("main_hidden", (512, 256, 128)))
     norm = ObsNormalizer(dims)
-    actor = GaussianHead(UniCrossNet(dims, n_act, norm, enc, main), n_act, cfg.get("init_log_std", -0.5))
+    actor = GaussianHead(UniCrossNet(dims, n_act, norm, enc, main), n_act, cfg.get("init_log_std", -0.5),
+                         cfg.get("action_init_scale", 1.0))
     policy = ProbabilisticActor(
         TensorDictModule(actor, in_keys=list(OBS_KEYS), out_keys=["loc", "scale"]),
         in_keys=["loc", "scale"], distribution_class=IndependentNormal, return_log_prob=True, spec=action_spec)
-    value = ValueOperator(UniCrossNet(dims, 1, norm, enc, main), in_keys=list(OBS_KEYS))
+    critic = ValueOperator(UniCrossNet(dims, 1, norm, enc, main), in_keys=list(OBS_KEYS),
+                           out_keys=["state_value_norm"])
+    value_norm = ValueNormalizer()
+    value = TensorDictSequential(critic, TensorDictModule(value_norm, in_keys=["state_value_norm"],
+                                                          out_keys=["state_value"]))
+    value.__dict__.update(critic=critic, value_norm=value_norm)  # handles, not extra registrations
     return policy, value, norm
 
 

@@ -32,6 +32,7 @@ from tqdm import tqdm
 
 from unicross import formulation as F
 from unicross.config import deep_merge, load_config
+from unicross.rewards import TERMS as REWARD_TERMS
 from unicross.rl.env import make_env
 from unicross.rl.models import OBS_KEYS, make_models, obs_dims_from_spec
 
@@ -39,10 +40,10 @@ SKILL_ENV = {"grasp": "UniCross-Grasp-v1", "relocate": "UniCross-Relocate-v1", "
              "translate": "UniCross-Translate-v1"}
 DEFAULT_HORIZON = {"grasp": 64, "relocate": 64, "rotate": 8, "translate": 8}
 CKPT_NAME = "checkpoint.pt"
-CSV_FIELDS = ["iteration", "frames", "fps", "collect_s", "update_s", "reward", "episodes", "episode_return",
-              "success_rate", "loss_objective", "loss_critic", "loss_entropy", "kl", "grad_norm", "lr",
-              "reward_contact", "reward_motion", "reward_track", "reward_pose", "reward_wrist_velocity",
-              "reward_energy", "reward_drop"]
+CSV_FIELDS = ["iteration", "frames", "fps", "collect_s", "update_s", "reward_raw", "reward_scaled", "episodes",
+              "episode_return", "success_rate", "loss_objective", "loss_critic", "entropy", "kl", "clip_fraction",
+              "ESS", "explained_variance", "value_clip_fraction", "grad_norm_actor", "grad_norm_critic", "lr",
+              "value_mean", "value_std", "nonfinite"] + [f"reward_{t}" for t in REWARD_TERMS]
 
 
 def git_commit() -> str:
@@ -93,11 +94,6 @@ def env_kwargs_for(skill: str, axis: Optional[str], hand: str, env_cfg: dict) ->
     return kw
 
 
-def gaussian_kl(loc0, scale0, loc1, scale1) -> torch.Tensor:
-    """KL(N0 || N1) of diagonal Gaussians, summed over action dims."""
-    return (torch.log(scale1 / scale0) + (scale0 ** 2 + (loc0 - loc1) ** 2) / (2 * scale1 ** 2) - 0.5).sum(-1)
-
-
 class PPOTrainer:
     """One expert: ``skill`` (+ ``axis`` for rotate/translate) on ``hand``."""
 
@@ -129,10 +125,17 @@ class PPOTrainer:
         self.policy.to(self.device)
         self.value.to(self.device)
         lc = cfg["loss"]
-        self.loss = ClipPPOLoss(self.policy, self.value, clip_epsilon=lc["clip_epsilon"],
-                                entropy_bonus=lc["entropy_coeff"] > 0, entropy_coeff=lc["entropy_coeff"],
+        if cfg["optim"]["schedule"] not in ("fixed", "adaptive"):
+            raise ValueError(f"optim.schedule must be 'fixed' or 'adaptive', not {cfg['optim']['schedule']!r}")
+        # the critic loss is taken in normalised return units (value targets standardised by
+        # running statistics), with PPO-style value clipping around the predictions that collected
+        self.loss = ClipPPOLoss(self.policy, self.value.critic, clip_epsilon=lc["clip_epsilon"],
+                                entropy_bonus=True, entropy_coeff=lc["entropy_coeff"],
                                 critic_coeff=lc["critic_coeff"], loss_critic_type=lc["loss_critic_type"],
-                                normalize_advantage=lc["normalize_advantage"])
+                                normalize_advantage=lc["normalize_advantage"], clip_value=lc["clip_value"])
+        self.loss.set_keys(value="state_value_norm", value_target="value_target_norm")
+        self._actor_params = list(self.policy.parameters())
+        self._critic_params = list(self.value.critic.parameters())
         self.gae = GAE(gamma=cfg["gae"]["gamma"], lmbda=cfg["gae"]["lmbda"], value_network=self.value,
                        average_gae=False)
         self.optim = torch.optim.Adam(self.loss.parameters(), lr=cfg["optim"]["lr"])
@@ -178,28 +181,31 @@ class PPOTrainer:
 
     # ------------------------------------------------------------------ evaluation
     @torch.no_grad()
-    def evaluate(self, episodes_per_env: int = 1, seed: int = 12345) -> dict:
-        """Deterministic rollouts (mean action): mean return and success of the first episode of
-        each env, ``episodes_per_env`` times."""
-        ep_len = load_config("task")["episode_length"][self.skill]
-        if getattr(self.env, "is_closed", False):  # the collector closes its env when it finishes
-            ec = self.cfg["env"]
-            self.env = make_env(self.env_id, self.env_kwargs, ec["num_envs"], ec["backend"])
-        env = self.env
-        returns, successes = [], []
-        for k in range(episodes_per_env):
-            env.set_seed(seed + k)
-            with set_exploration_type(ExplorationType.DETERMINISTIC):
-                td = env.rollout(ep_len, self.policy, break_when_any_done=False)
-            td = td if len(env.batch_size) else td.unsqueeze(0)  # [B, T]
-            done = td["next", "done"].squeeze(-1)
-            first = torch.where(done.any(-1), done.float().argmax(-1), torch.full_like(done[:, 0], ep_len - 1, dtype=torch.long))
-            t = torch.arange(done.shape[1], device=done.device)
-            mask = (t[None] <= first[:, None]).float()
-            returns.append((td["next", "reward"].squeeze(-1) * mask).sum(-1))
-            successes.append(td["next", "info", "success"].squeeze(-1).gather(1, first[:, None]).squeeze(1).float())
-        r, s = torch.cat(returns), torch.cat(successes)
-        return dict(eval_return=float(r.mean()), eval_success=float(s.mean()), eval_episodes=int(r.numel()))
+    def evaluate(self) -> dict:
+        """The paper's protocol for this expert's skill (and axis), deterministic actions, on a
+        fixed held-out set (``logging.eval_objects``, first ``eval_limit`` objects per group,
+        ``eval_trials`` trials each) with fixed seeds: every evaluation of a run sees the same
+        objects and starts, in its own in-process env (not the training workers)."""
+        from unicross import evaluation as E
+        from unicross.objects import get_object_set
+        from unicross.rl.policy_io import act
+        lc = self.cfg["logging"]
+        objs = get_object_set(lc["eval_objects"], limit=lc["eval_limit"])
+        self.policy.eval()
+        try:
+            trials = E.run_protocol(self.skill, lambda obs, u: act(self.policy, obs), objs, hand=self.hand,
+                                    trials_per_object=lc["eval_trials"], seed=lc["eval_seed"], progress=False,
+                                    axes=[self.axis] if self.axis else None,
+                                    ablation=(self.cfg["env"].get("task_config") or {}).get("ablation"))
+        finally:
+            self.policy.train()
+        summ = E.summarize(self.skill, trials)
+        out = dict(eval_success=summ["sr"] / 100.0, eval_ci95_low=summ["ci95"][0] / 100.0,
+                   eval_ci95_high=summ["ci95"][1] / 100.0, eval_n=summ["n"])
+        for k in ("pe_cm", "ae_rad", "rot_rad", "trans_cm"):
+            if k in summ:
+                out[f"eval_{k}"] = summ[k]
+        return out
 
     # ------------------------------------------------------------------ training
     def _episode_stats(self, data: TensorDict) -> dict:
@@ -223,17 +229,36 @@ class PPOTrainer:
         return out
 
     def _update(self, data: TensorDict) -> dict:
+        """One PPO update on a collected batch ``data`` [..., T]: GAE on scaled rewards, return
+        statistics, then ``mini_epochs`` passes of minibatches through ClipPPOLoss (policy) and
+        the clipped critic loss in normalised units; actor and critic gradients are clipped
+        separately. Returns the mean of the loss module's own diagnostics."""
         oc = self.cfg["optim"]
+        fitted_first = bool(self.norm.count < 1)
+        if fitted_first:  # first batch: fit the observation statistics before any update, and express
+            # the behaviour distribution under them (the initial action mean is ~0 either way)
+            self.norm.update({k: data[k] for k in OBS_KEYS})
+            with torch.no_grad():
+                obs = data.select(*OBS_KEYS).clone()
+                loc_scale = self.policy.module[0](obs)
+                data["loc"], data["scale"] = loc_scale["loc"], loc_scale["scale"]
+                data["action_log_prob"] = self.policy.get_dist(obs).log_prob(data["action"])
         data["next", "reward"] = data["next", "reward"] * self.cfg["gae"]["reward_scale"]
         with torch.no_grad():
             self.gae(data)
+            vn = self.value.value_norm
+            vn.update(data["value_target"])
+            data["value_target_norm"] = vn.normalize(data["value_target"])
+            data["state_value_norm"] = vn.normalize(data["state_value"])  # old predictions, new units
         flat = data.reshape(-1)
         self.rb.empty()
         self.rb.extend(flat)
         n_mb = max(1, self.frames_per_batch // self.minibatch)
-        stats = {"loss_objective": 0.0, "loss_critic": 0.0, "loss_entropy": 0.0, "kl": 0.0, "grad_norm": 0.0}
+        keys = ("loss_objective", "loss_critic", "entropy", "kl_approx", "clip_fraction", "ESS",
+                "explained_variance", "value_clip_fraction")
+        stats = {k: 0.0 for k in keys}
+        stats.update(grad_norm_actor=0.0, grad_norm_critic=0.0)
         count = 0
-        actor = self.policy.module[0]  # TensorDictModule producing loc, scale
         for _ in range(oc["mini_epochs"]):
             for _ in range(n_mb):
                 mb = self.rb.sample()
@@ -243,29 +268,38 @@ class PPOTrainer:
                     loss = loss + losses["loss_entropy"]
                 self.optim.zero_grad(set_to_none=True)
                 loss.backward()
-                gn = torch.nn.utils.clip_grad_norm_(self.loss.parameters(), oc["max_grad_norm"])
+                ga = torch.nn.utils.clip_grad_norm_(self._actor_params, oc["max_grad_norm"])
+                gc = torch.nn.utils.clip_grad_norm_(self._critic_params, oc["max_grad_norm_critic"])
                 self.optim.step()
-                with torch.no_grad():
-                    new = actor(mb.select(*OBS_KEYS).clone())
-                    kl = gaussian_kl(mb["loc"], mb["scale"], new["loc"], new["scale"]).mean()
-                # KL-adaptive learning rate (rl_games): shrink when the policy moved too far
-                klv = float(kl)
-                if klv > 2.0 * oc["kl_threshold"]:
-                    self.lr = max(self.lr / 1.5, oc["lr_min"])
-                elif klv < 0.5 * oc["kl_threshold"]:
-                    self.lr = min(self.lr * 1.5, oc["lr_max"])
-                for g in self.optim.param_groups:
-                    g["lr"] = self.lr
-                for k in ("loss_objective", "loss_critic", "loss_entropy"):
+                klv = float(losses["kl_approx"])
+                self._schedule_lr(klv)
+                for k in keys:
                     if k in losses.keys():
-                        stats[k] += float(losses[k].detach())
-                stats["kl"] += klv
-                stats["grad_norm"] += float(gn)
+                        stats[k] += float(losses[k].detach().float().mean())
+                stats["grad_norm_actor"] += float(ga)
+                stats["grad_norm_critic"] += float(gc)
                 count += 1
-        self.norm.update({k: flat[k] for k in OBS_KEYS})
+        if not fitted_first:
+            self.norm.update({k: flat[k] for k in OBS_KEYS})
         out = {k: v / count for k, v in stats.items()}
+        out["kl"] = out.pop("kl_approx")
         out["lr"] = self.lr
+        out["value_mean"], out["value_std"] = float(vn.mean), float(vn.std())
         return out
+
+    def _schedule_lr(self, kl: float) -> None:
+        """``optim.schedule``: ``fixed``, or ``adaptive`` (rl_games): the rate shrinks by 1.5 when
+        the minibatch KL exceeds twice ``kl_threshold`` and grows by 1.5 below half of it, within
+        [``lr_min``, ``lr_max``] (a floor that keeps learning alive)."""
+        oc = self.cfg["optim"]
+        if oc["schedule"] == "fixed":
+            return
+        if kl > 2.0 * oc["kl_threshold"]:
+            self.lr = max(self.lr / 1.5, oc["lr_min"])
+        elif kl < 0.5 * oc["kl_threshold"]:
+            self.lr = min(self.lr * 1.5, oc["lr_max"])
+        for g in self.optim.param_groups:
+            g["lr"] = self.lr
 
     def train(self, max_iterations: Optional[int] = None, eval_at_ends: bool = True) -> dict:
         total = self.cfg["collector"]["total_frames"]
@@ -274,9 +308,11 @@ class PPOTrainer:
         (self.run_dir / "config.json").write_text(json.dumps(dict(config=self.cfg, skill=self.skill, axis=self.axis,
                                                                   hand=self.hand, git_commit=git_commit()), indent=1))
         summary = {}
-        if eval_at_ends and self.iteration == 0 and self.cfg["logging"]["eval_episodes"] > 0:
-            summary["start"] = self.evaluate(self._eval_rounds())
-            self._log_json({"iteration": 0, "frames": 0, **summary["start"]})
+        lc = self.cfg["logging"]
+        evaluating = eval_at_ends and lc["eval_trials"] > 0
+        if evaluating and self.iteration == 0:
+            summary["start"] = self.evaluate()
+            self._log_eval(summary["start"], writer=None)
         if remaining == 0:
             return summary
         collector = Collector(self.env, self.policy, frames_per_batch=self.frames_per_batch, total_frames=remaining,
@@ -291,6 +327,8 @@ class PPOTrainer:
                 self.iteration += 1
                 self.frames += data.numel()
                 ep = self._episode_stats(data)
+                reward_raw = float(data["next", "reward"].mean())
+                ep["nonfinite"] = int(data["next", "info", "nonfinite"].sum())
                 t0 = time.perf_counter()
                 up = self._update(data)
                 t_update = time.perf_counter() - t0
@@ -298,13 +336,15 @@ class PPOTrainer:
                 terms = {k: float(data["next", "info", k].mean()) for k in data["next", "info"].keys()
                          if k.startswith("reward_")}
                 row = dict(iteration=self.iteration, frames=self.frames, fps=data.numel() / max(t_collect + t_update, 1e-9),
-                           collect_s=t_collect, update_s=t_update, reward=float(data["next", "reward"].mean()),
-                           **ep, **up, **terms)
+                           collect_s=t_collect, update_s=t_update, reward_raw=reward_raw,
+                           reward_scaled=reward_raw * self.cfg["gae"]["reward_scale"], **ep, **up, **terms)
                 self._log(row, writer)
                 bar.update(data.numel())
                 bar.set_postfix(ret=f"{row.get('episode_return', float('nan')):.2f}", succ=f"{row.get('success_rate', float('nan')):.2f}")
-                if self.iteration % self.cfg["logging"]["checkpoint_every"] == 0:
+                if self.iteration % lc["checkpoint_every"] == 0:
                     self.save()
+                if evaluating and lc["eval_every"] and self.iteration % lc["eval_every"] == 0:
+                    self._log_eval(self.evaluate(), writer)
                 done_iters += 1
                 t_last = time.perf_counter()
                 if max_iterations is not None and done_iters >= max_iterations:
@@ -315,13 +355,30 @@ class PPOTrainer:
             collector.shutdown(close_env=False)
             if writer is not None:
                 writer.close()
-        if eval_at_ends and self.cfg["logging"]["eval_episodes"] > 0 and self.frames >= total:
-            summary["end"] = self.evaluate(self._eval_rounds())
-            self._log_json({"iteration": self.iteration, "frames": self.frames, **summary["end"]})
+        if evaluating and self.frames >= total:
+            summary["end"] = self.evaluate()
+            self._log_eval(summary["end"], writer=None)
         return summary
 
-    def _eval_rounds(self) -> int:
-        return max(1, self.cfg["logging"]["eval_episodes"] // self.batch_envs)
+    def _log_eval(self, row: dict, writer) -> None:
+        """Evaluation rows go to metrics.jsonl, eval.csv and TensorBoard (``eval/*``)."""
+        row = {"iteration": self.iteration, "frames": self.frames, **row}
+        self._log_json(row)
+        path = self.run_dir / "eval.csv"
+        new = not path.exists()
+        with open(path, "a", newline="") as f:
+            w = csv.DictWriter(f, fieldnames=list(row))
+            if new:
+                w.writeheader()
+            w.writerow(row)
+        own = writer is None
+        writer = writer or self._tb()
+        if writer is not None:
+            for k, v in row.items():
+                if k not in ("iteration", "frames"):
+                    writer.add_scalar(f"eval/{k}", v, self.frames)
+            if own:
+                writer.close()
 
     # ------------------------------------------------------------------ logging
     def _tb(self):

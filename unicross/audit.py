@@ -1,0 +1,166 @@
+"""Reward audit: what PPO would be paid for reference behaviours of one mode.
+
+Each reference behaviour is rolled out in the training task (the env settings of
+``configs/ppo.yaml``: its ``task_config`` and ``reward_config`` overrides, randomisation on) over
+the same objects and seeds. Every reward term is summed as PPO sees it: discounted by the GAE's
+``gamma`` and multiplied by ``reward_scale``. Behaviours are ranked by that total; a reward is
+sound for a mode when its successful reference ranks first.
+
+Grasp behaviours (scripted on the task's own state, through the normal action interface):
+
+  scripted       descend, close, lift (the scripted grasp synthesiser's policy)
+  descend_close  descend and close, then hold still (the task's lift phase raises the wrist)
+  hover          descend, never close
+  close_only     close the fingers where the hand starts (above the object)
+  zero           no action
+  random         uniform random actions
+
+Relocate: ``naive`` (the paper's naive baseline: wrist driven to the goal, fingers tightened),
+``zero``, ``random``.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable, Dict, List, Optional
+
+import gymnasium as gym
+import torch
+
+from unicross import formulation as F
+from unicross.config import load_config
+
+from unicross.rewards import TERMS
+SKILL_ENV = {"grasp": "UniCross-Grasp-v1", "relocate": "UniCross-Relocate-v1", "rotate": "UniCross-Rotate-v1",
+             "translate": "UniCross-Translate-v1"}
+
+
+# ----------------------------------------------------------------------------- reference behaviours
+def _grasp_script(lift: bool, close: bool, descend: bool):
+    from unicross.scripted_grasp import ScriptedGrasp
+
+    def make(u):
+        script = ScriptedGrasp(u, lift_height=0.15 if lift else 0.0)
+
+        def act():
+            t = script.t
+            a = script()
+            if not descend and t < script.t_close:
+                a[:, :3] = 0.0
+            if not close and script.t_close <= t < script.t_settle:
+                a[:, 6:] = 0.0
+            return a
+        return act
+    return make
+
+
+def _zero(u):
+    return lambda: torch.zeros(u.num_envs, u.hand_spec.dof, device=u.device)
+
+
+def _random_factory(seed: int):
+    def make(u):
+        g = torch.Generator().manual_seed(seed)
+        return lambda: (torch.rand(u.num_envs, u.hand_spec.dof, generator=g) * 2 - 1).to(u.device)
+    return make
+
+
+def _naive_relocate(u):
+    from unicross.evaluation import scripted_relocate_policy
+    return lambda: scripted_relocate_policy(None, u)
+
+
+def behaviours(skill: str, seed: int = 0) -> Dict[str, Callable]:
+    """name -> factory(u) -> act() for the reference behaviours of ``skill``; the first is the
+    successful reference."""
+    common = dict(zero=_zero, random=_random_factory(seed))
+    if skill == "grasp":
+        return dict(scripted=_grasp_script(lift=True, close=True, descend=True),
+                    descend_close=_grasp_script(lift=False, close=True, descend=True),
+                    hover=_grasp_script(lift=False, close=False, descend=True),
+                    close_only=_grasp_script(lift=False, close=True, descend=False), **common)
+    if skill == "relocate":
+        return dict(naive=_naive_relocate, **common)
+    raise ValueError(f"no reference behaviours for skill {skill!r} yet; available: grasp, relocate")
+
+
+# ----------------------------------------------------------------------------- rollouts
+@dataclass
+class AuditRow:
+    behaviour: str
+    episodes: int
+    success: float
+    total: float                # mean discounted, scaled return
+    terms: Dict[str, float]     # mean discounted, scaled return per term
+    undiscounted: float         # mean raw (unscaled, undiscounted) return
+    min_total: float            # worst episode (discounted, scaled)
+
+
+def audit(skill: str = "grasp", axis: Optional[str] = None, objects: Optional[str] = None, limit: int = 2,
+          seeds: int = 3, hand: str = "allegro", ppo_overrides: Optional[dict] = None,
+          only: Optional[List[str]] = None, progress: bool = True) -> List[AuditRow]:
+    """Rolls every reference behaviour of ``skill`` out on the first ``limit`` objects per group
+    of ``objects`` (default: the skill's training set) for ``seeds`` seeds each, in the PPO
+    training env; returns the rows ranked by discounted scaled return (best first)."""
+    import unicross  # noqa: F401  (registers the tasks)
+    from tqdm import tqdm
+    from unicross.objects import get_object_set
+    from unicross.rl.ppo import env_kwargs_for
+    cfg = load_config("ppo", ppo_overrides)
+    gamma, scale = cfg["gae"]["gamma"], cfg["gae"]["reward_scale"]
+    kw = env_kwargs_for(skill, axis, hand, cfg["env"])
+    kw.pop("object_limit", None)
+    kw.pop("reconfiguration_freq", None)
+    default_set = {"grasp": "train", "relocate": "train", "rotate": "train-wrappable",
+                   "translate": "train-elongated"}[skill]
+    objs = get_object_set(objects or default_set, limit=limit)
+    beh = behaviours(skill)
+    if only:
+        bad = [b for b in only if b not in beh]
+        if bad:
+            raise ValueError(f"unknown behaviour(s) {bad}; valid for {skill}: {list(beh)}")
+        beh = {k: v for k, v in beh.items() if k in only}
+    acc = {b: dict(total=[], raw=[], succeeded=[], terms={t: [] for t in TERMS}) for b in beh}
+    bar = tqdm(total=len(objs) * seeds * len(beh), desc=f"audit {skill}", disable=not progress)
+    for oi, obj in enumerate(objs):
+        env = gym.make(SKILL_ENV[skill], obs_mode="state_dict", sim_backend="physx_cpu", render_backend="none",
+                       num_envs=1, **{**kw, "objects": [obj]})
+        u = env.unwrapped
+        length = int(u.episode_length[u.mode[0]])
+        for name, make in beh.items():
+            for k in range(seeds):
+                u.reset(seed=10_007 * oi + k)
+                act = make(u)
+                disc = 1.0
+                ret = {t: 0.0 for t in TERMS}
+                raw, success = 0.0, False
+                for _ in range(length):
+                    _, r, term, trunc, info = u.step(act())
+                    for t in TERMS:
+                        ret[t] += disc * scale * float(info[f"reward_{t}"][0])
+                    raw += float(r[0])
+                    disc *= gamma
+                    success = bool(info["success"][0])
+                    if bool(term[0]) or bool(trunc[0]):
+                        break
+                for t in TERMS:
+                    acc[name]["terms"][t].append(ret[t])
+                acc[name]["total"].append(sum(ret.values()))
+                acc[name]["raw"].append(raw)
+                acc[name]["succeeded"].append(float(success))
+                bar.update(1)
+        env.close()
+    bar.close()
+    mean = lambda xs: sum(xs) / max(len(xs), 1)
+    rows = [AuditRow(b, len(a["total"]), mean(a["succeeded"]), mean(a["total"]), {t: mean(a["terms"][t]) for t in TERMS},
+                     mean(a["raw"]), min(a["total"])) for b, a in acc.items()]
+    return sorted(rows, key=lambda r: -r.total)
+
+
+def format_rows(rows: List[AuditRow]) -> str:
+    head = "| rank | behaviour | n | success | return (disc., scaled) | worst | raw return | " + \
+           " | ".join(TERMS) + " |"
+    lines = [head, "|" + "---|" * (7 + len(TERMS))]
+    for i, r in enumerate(rows, 1):
+        lines.append(f"| {i} | {r.behaviour} | {r.episodes} | {100 * r.success:.0f}% | {r.total:.3f} | "
+                     f"{r.min_total:.3f} | {r.undiscounted:.1f} | " + " | ".join(f"{r.terms[t]:.3f}" for t in TERMS) + " |")
+    return "\n".join(lines)
