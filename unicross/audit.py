@@ -15,8 +15,17 @@ Grasp behaviours (scripted on the task's own state, through the normal action in
   zero           no action
   random         uniform random actions
 
-Relocate: ``naive`` (the paper's naive baseline: wrist driven to the goal, fingers tightened),
-``zero``, ``random``.
+Relocate: ``follow`` (zero residual action: the wrist follows the task's interpolated target
+with the object held: the successful reference), ``naive`` (the paper's naive baseline: wrist
+driven straight to the goal, fingers tightened), ``stay`` (the wrist holds its start pose) and
+``random``.
+
+Rotate and translate: ``oracle``, ``zero``, ``random``. The oracle is a kinematic reference:
+the hand holds still (zero action) and, after each control step's physics, the object is placed
+in the hand advanced by the mode's own speed (``omega_max`` about the hand-frame axis through
+the object's centre, or ``v_max`` along it) with zero velocity. The reward then measures the
+motion the mode asks for, exactly, with the contacts the physics produced: what the reward
+would pay a policy that does the skill.
 """
 from __future__ import annotations
 
@@ -64,9 +73,48 @@ def _random_factory(seed: int):
     return make
 
 
+def _stay(u):
+    """Wrist actions that cancel the target's motion: the hand stays where it started."""
+    start = F.wrist_reference(u.targets).clone()
+
+    def act():
+        a = torch.zeros(u.num_envs, u.hand_spec.dof, device=u.device)
+        a[:, :6] = (start - F.wrist_reference(u.targets)) / u.action_scale[:6]
+        return a.clamp(-1.0, 1.0)
+    return act
+
+
 def _naive_relocate(u):
     from unicross.evaluation import scripted_relocate_policy
     return lambda: scripted_relocate_policy(None, u)
+
+
+def _oracle(u):
+    """Kinematic in-hand motion (see the module docstring); installs a per-instance hook that
+    :func:`audit` removes after the episode."""
+    from mani_skill.utils.structs.pose import Pose
+    from unicross.geometry import pose_mul, quat_from_axis_angle, quat_mul, quat_positive
+    axis = F.MODE_AXES.to(u.device)[u.mode]
+    rotate = F.mode_skill(F.MODES[int(u.mode[0])]) == "rotate"
+    step_angle = u.cfg["motion"]["omega_max"] * u.control_dt
+    step_dist = u.cfg["motion"]["v_max"] * u.control_dt
+    held = dict(x=u.cur_rel.x_oh.clone(), q=u.cur_rel.q_oh.clone())
+
+    def after_control_step():
+        if rotate:
+            dq = quat_from_axis_angle(axis, torch.full((u.num_envs,), step_angle, device=u.device))
+            held["q"] = quat_positive(quat_mul(dq, held["q"]))
+        else:
+            held["x"] = held["x"] + axis * step_dist
+        pos, quat = u.sensor.poses()
+        p, q = pose_mul(pos[:, 0], quat[:, 0], held["x"], held["q"])
+        u.obj.set_pose(Pose.create_from_pq(p, q))
+        zero = torch.zeros(u.num_envs, 3, device=u.device)
+        u.obj.set_linear_velocity(zero)
+        u.obj.set_angular_velocity(zero)
+
+    u._after_control_step = after_control_step
+    return _zero(u)
 
 
 def behaviours(skill: str, seed: int = 0) -> Dict[str, Callable]:
@@ -79,8 +127,10 @@ def behaviours(skill: str, seed: int = 0) -> Dict[str, Callable]:
                     hover=_grasp_script(lift=False, close=False, descend=True),
                     close_only=_grasp_script(lift=False, close=True, descend=False), **common)
     if skill == "relocate":
-        return dict(naive=_naive_relocate, **common)
-    raise ValueError(f"no reference behaviours for skill {skill!r} yet; available: grasp, relocate")
+        return dict(follow=_zero, naive=_naive_relocate, stay=_stay, random=common["random"])
+    if skill in ("rotate", "translate"):
+        return dict(oracle=_oracle, **common)
+    raise ValueError(f"unknown skill {skill!r}; valid: grasp, relocate, rotate, translate")
 
 
 # ----------------------------------------------------------------------------- rollouts
@@ -142,6 +192,7 @@ def audit(skill: str = "grasp", axis: Optional[str] = None, objects: Optional[st
                     success = bool(info["success"][0])
                     if bool(term[0]) or bool(trunc[0]):
                         break
+                u.__dict__.pop("_after_control_step", None)  # the oracle's hook, if any
                 for t in TERMS:
                     acc[name]["terms"][t].append(ret[t])
                 acc[name]["total"].append(sum(ret.values()))

@@ -4,6 +4,7 @@
     unicross hands                        registered hands and their DoF
     unicross grasps --objects SET ...     synthesise a grasp-state dataset (scripted) and hold-test it
     unicross rollout --task ID ...        run random or zero actions and print per-term rewards
+    unicross audit --skill SKILL          reward audit: returns of reference behaviours as PPO sees them
     unicross train --skill SKILL ...      train one expert with PPO (resumable)
     unicross distill --experts DIR ...    DAgger distillation of the ten experts into one student
     unicross chain --policy P --sequence grasp,relocate,rotate:x+   one continuous long-horizon episode
@@ -148,8 +149,13 @@ def parse_sets(items) -> dict:
 
 
 def overrides_from(args, **flags) -> dict:
-    """``--set`` overrides plus the scale flags (which win): flags map "section.key" -> value."""
-    overrides = parse_sets(args.set)
+    """``--preset`` overrides, then ``--set`` overrides, then the scale flags (each wins over the
+    one before): flags map "section.key" -> value."""
+    from unicross.config import deep_merge, load_preset
+    overrides = {}
+    for name in getattr(args, "preset", None) or []:
+        overrides = deep_merge(overrides, load_preset(name), strict=False)
+    overrides = deep_merge(overrides, parse_sets(args.set), strict=False)
     for path, value in flags.items():
         if value is not None:
             section, key = path.split(".")
@@ -176,6 +182,22 @@ def _cmd_train(args) -> int:
     for k, v in summary.items():
         print(f"{k}: " + ", ".join(f"{a}={b:.4g}" if isinstance(b, float) else f"{a}={b}" for a, b in v.items()))
     print(f"checkpoint: {trainer.run_dir / 'checkpoint.pt'} (iteration {trainer.iteration}, {trainer.frames} frames)")
+    return 0
+
+
+def _cmd_audit(args) -> int:
+    from unicross.audit import audit, format_rows
+    overrides = overrides_from(args)
+    rows = audit(args.skill, args.axis, args.objects, args.limit, args.seeds, args.hand,
+                 ppo_overrides=overrides or None, only=args.only.split(",") if args.only else None)
+    table = format_rows(rows)
+    print(table)
+    ref = next(iter(__import__("unicross.audit", fromlist=["behaviours"]).behaviours(args.skill)))
+    print(f"successful reference ({ref}) ranks {1 + [r.behaviour for r in rows].index(ref)} of {len(rows)}"
+          if ref in [r.behaviour for r in rows] else "")
+    if args.out:
+        Path(args.out).parent.mkdir(parents=True, exist_ok=True)
+        Path(args.out).write_text(json.dumps([r.__dict__ for r in rows], indent=1))
     return 0
 
 
@@ -366,7 +388,21 @@ def main(argv=None) -> int:
     s.add_argument("--video", default=None, help="record the first trial and render it to this .mp4")
     s.add_argument("--out", default=None, help="JSON with every trial")
     s.set_defaults(fn=_cmd_chain)
+    s = sub.add_parser("audit", help="reward audit: discounted, scaled returns of reference behaviours, ranked")
+    s.add_argument("--skill", choices=["grasp", "relocate", "rotate", "translate"], default="grasp")
+    s.add_argument("--axis", default=None, help="rotate: x+,x-,y+,y-,z+,z-; translate: z+,z-")
+    s.add_argument("--objects", default=None, help="object set (default: the skill's training set)")
+    s.add_argument("--limit", type=int, default=2, help="first N objects per (category, type) group")
+    s.add_argument("--seeds", type=int, default=3, help="episodes per object and behaviour")
+    s.add_argument("--only", default=None, help="comma list of behaviours (default: all)")
+    s.add_argument("--hand", default="allegro")
+    s.add_argument("--preset", action="append", metavar="NAME", help="configs/presets/NAME.yaml (e.g. paper_reward)")
+    s.add_argument("--set", action="append", metavar="SECTION.KEY=VALUE", help="override configs/ppo.yaml")
+    s.add_argument("--out", default=None, help="JSON with the rows")
+    s.set_defaults(fn=_cmd_audit)
     s = sub.add_parser("train", help="train one expert with PPO (TorchRL); resumable")
+    s.add_argument("--preset", action="append", metavar="NAME",
+                   help="configs/presets/NAME.yaml: paper_gpu (the paper's PPO values), paper_reward (its exact reward)")
     s.add_argument("--skill", choices=["grasp", "relocate", "rotate", "translate"], default=None)
     s.add_argument("--axis", default=None, help="rotate: x+,x-,y+,y-,z+,z-; translate: z+,z-")
     s.add_argument("--direction", dest="axis", help=argparse.SUPPRESS)

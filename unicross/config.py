@@ -41,3 +41,16 @@ def load_config(name: str, overrides: Optional[Mapping[str, Any]] = None) -> dic
     with open(path) as f:
         data = yaml.safe_load(f)
     return deep_merge(data, overrides)
+
+
+def preset_names() -> list:
+    return sorted(p.stem for p in (CONFIG_DIR / "presets").glob("*.yaml"))
+
+
+def load_preset(name: str) -> dict:
+    """``configs/presets/<name>.yaml``: a named set of overrides (e.g. the paper's exact values)."""
+    path = CONFIG_DIR / "presets" / f"{name}.yaml"
+    if not path.exists():
+        raise ValueError(f"unknown preset {name!r}; valid: {preset_names()}")
+    with open(path) as f:
+        return yaml.safe_load(f) or {}

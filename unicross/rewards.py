@@ -25,9 +25,11 @@ TRACK_WEIGHTS = dict(x_or="w_opr", q_or="w_oqr", x_oh="w_oph", q_oh="w_oqh", x_h
 
 
 def contact_reward(distance: torch.Tensor, contact: torch.Tensor, force: torch.Tensor,
-                   w_dis: torch.Tensor, w_con: torch.Tensor, w_f: torch.Tensor) -> torch.Tensor:
-    """(1/N) Σ_links (-w_dis·d_i + w_con·c_i + w_f·f_i); distance/contact/force are [B, L]."""
-    per_link = -w_dis[:, None] * distance + w_con[:, None] * contact + w_f[:, None] * force
+                   w_dis: torch.Tensor, w_con: torch.Tensor, w_f: torch.Tensor,
+                   max_distance: float = float("inf")) -> torch.Tensor:
+    """(1/N) Σ_links (-w_dis·min(d_i, max_distance) + w_con·c_i + w_f·f_i); distance/contact/force
+    are [B, L]. The saturation bounds the term when an object is lost (it can fall past the table)."""
+    per_link = -w_dis[:, None] * distance.clamp(max=max_distance) + w_con[:, None] * contact + w_f[:, None] * force
     return per_link.mean(dim=-1)
 
 
@@ -79,6 +81,7 @@ class RewardTerms:
         self.w_con = per_mode(lambda s: cfg["contact"][s]["w_con"])
         self.w_f = per_mode(lambda s: cfg["contact"][s]["w_f"])
         self.w_p = per_mode(lambda s: cfg["motion"][s])
+        self.max_distance = float(cfg["contact_max_distance"])
         self.w_success = per_mode(lambda s: cfg["success"][s])
         self.w_pose = per_mode(lambda s: cfg["pose"][s])
         t = cfg["track"]
@@ -92,7 +95,7 @@ class RewardTerms:
         """``m`` holds the step's measurements (see UniCrossEnv.evaluate)."""
         terms = dict(
             contact=contact_reward(m["link_distance"], m["contact"].float(), m["force_clipped"],
-                                   self.w_dis[mode], self.w_con[mode], self.w_f[mode]),
+                                   self.w_dis[mode], self.w_con[mode], self.w_f[mode], self.max_distance),
             motion=motion_reward(m["speed_along_axis"], m["speed_cap"], self.w_p[mode]),
             success=success_reward(m["success"], self.w_success[mode]),
             track=tracking_reward(m["relational"], m["reward_targets"], self.track_pos, self.track_rot,

@@ -10,9 +10,43 @@ from unicross.rl.env import obs_to_td
 from unicross.rl.models import make_models
 
 
+SHIPPED_DIR = Path(__file__).resolve().parent.parent / "checkpoints"
+SHIPPED_KEYS = ("policy", "obs_dims", "n_act", "config", "skill", "axis", "hand", "env_id", "env_kwargs",
+                "iteration", "frames", "git_commit")
+
+
+def resolve_checkpoint(spec) -> Path:
+    """A checkpoint path, or the shorthand ``<hand>/<mode>`` of a shipped one
+    (``unicross/checkpoints/<hand>/<mode>.pt``, e.g. ``allegro/grasp``)."""
+    path = Path(spec)
+    if path.exists() or path.suffix:
+        return path
+    shipped = SHIPPED_DIR / f"{spec}.pt"
+    if shipped.exists():
+        return shipped
+    have = sorted(str(p.relative_to(SHIPPED_DIR).with_suffix("")) for p in SHIPPED_DIR.glob("*/*.pt"))
+    raise FileNotFoundError(f"checkpoint not found: {spec} (shipped checkpoints: {have})")
+
+
+def export_policy(run_checkpoint, out, sidecar: dict) -> Path:
+    """Writes the acting part of a PPO run checkpoint (policy weights with their observation
+    statistics, sizes, config; no critic or optimiser) to ``out`` and ``sidecar`` (plus the
+    checkpoint's own facts) to ``out`` with suffix ``.json``."""
+    import json
+    ck = torch.load(run_checkpoint, map_location="cpu", weights_only=False)
+    small = {k: ck[k] for k in SHIPPED_KEYS if k in ck}
+    out = Path(out)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    torch.save(small, out)
+    facts = {k: small[k] for k in ("skill", "axis", "hand", "iteration", "frames", "git_commit") if k in small}
+    out.with_suffix(".json").write_text(json.dumps({**facts, **sidecar}, indent=1) + "\n")
+    return out
+
+
 def load_policy(path, device="cpu"):
-    """(policy, checkpoint) from a PPO checkpoint; fails with a clear message if missing/invalid."""
-    path = Path(path)
+    """(policy, checkpoint) from a PPO checkpoint (or a shipped ``<hand>/<mode>``); fails with a
+    clear message if missing/invalid."""
+    path = resolve_checkpoint(path)
     if not path.exists():
         raise FileNotFoundError(f"checkpoint not found: {path}")
     ck = torch.load(path, map_location=device, weights_only=False)

@@ -1,0 +1,68 @@
+"""Learning curves of PPO runs as one PNG: held-out evaluation success (paper protocol, with its
+95% Wilson interval) and training-episode return against frames, one line per run.
+
+    python benchmarks/plot_curves.py runs/grasp_s0 runs/grasp_s1 runs/grasp_s2 --out docs/grasp_curves.png
+
+Reads each run's ``metrics.jsonl`` (written by ``unicross train``). Needs matplotlib
+(``pip install matplotlib``).
+"""
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+
+def load(run: Path):
+    rows = [json.loads(line) for line in (run / "metrics.jsonl").read_text().splitlines() if line.strip()]
+    evals = [r for r in rows if "eval_success" in r]
+    train = [r for r in rows if "episode_return" in r]
+    return evals, train
+
+
+def smooth(xs, k: int = 10):
+    out, acc = [], []
+    for x in xs:
+        acc.append(x)
+        acc = acc[-k:]
+        out.append(sum(acc) / len(acc))
+    return out
+
+
+def main(argv=None) -> int:
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("runs", nargs="+")
+    p.add_argument("--out", required=True)
+    p.add_argument("--title", default=None)
+    args = p.parse_args(argv)
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, (a, b) = plt.subplots(1, 2, figsize=(11, 4))
+    for run in map(Path, args.runs):
+        evals, train = load(run)
+        if evals:
+            f = [r["frames"] for r in evals]
+            line, = a.plot(f, [100 * r["eval_success"] for r in evals], marker="o", ms=3, label=run.name)
+            a.fill_between(f, [100 * r["eval_ci95_low"] for r in evals], [100 * r["eval_ci95_high"] for r in evals],
+                           color=line.get_color(), alpha=0.12)
+        if train:
+            b.plot([r["frames"] for r in train], smooth([r["episode_return"] for r in train]), label=run.name)
+    n = evals[0]["eval_n"] if evals else 0
+    a.set(xlabel="frames", ylabel="success (%)", ylim=(-2, 102),
+          title=f"held-out evaluation (paper protocol, n={n} each, 95% CI)")
+    b.set(xlabel="frames", ylabel="episode return (raw, smoothed)", title="training episodes")
+    for ax in (a, b):
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8)
+    if args.title:
+        fig.suptitle(args.title)
+    fig.tight_layout()
+    Path(args.out).parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(args.out, dpi=110)
+    print(f"wrote {args.out}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
