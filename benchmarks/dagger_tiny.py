@@ -33,7 +33,7 @@ def main():
         t = PPOTrainer(root / "experts" / mode, skill, axis, progress=False, overrides=dict(
             env=dict(num_envs=1, object_limit=1, reconfiguration_freq=0),
             collector=dict(total_frames=16, horizon=16), optim=dict(minibatch_size=16, mini_epochs=1),
-            logging=dict(eval_trials=0)))
+            logging=dict(eval_trials=0, final_eval_trials=0)))
         t.train(eval_at_ends=False)
         t.close()
         rows = list(csv.DictReader(open(root / "experts" / mode / "metrics.csv")))

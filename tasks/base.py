@@ -584,19 +584,6 @@ class UniCrossEnv(BaseEnv):
         self.trans_acc = self.trans_acc + (pend & is_trans).float() * (v * axis_prev).sum(-1) * dt
         # reward compares against the targets the last action aimed at; Free targets = current
         reward_targets = F.with_free_as_current(self.mode, self.targets, cur)
-        # advance the targets
-        axis = F.task_axis(self.mode, cur, self.final_x_or)
-        init = self.init_rel.clone()
-        init.x_or = init.x_or + self.lift
-        new_t = F.update_targets(self.mode, cur, init, self.final_x_or, self.final_q_or, axis, self.motion,
-                                 skill=self.static_skill)
-        self.targets = new_t.where(pend, self.targets)
-        self.axis = torch.where(p1, axis, self.axis)
-        self.prev_rel = cur.where(pend, self.prev_rel)
-        self.cur_rel = cur
-        if self._obs_noise_on:
-            self.obs_noise = torch.where(p1, self._draw_obs_noise(self.num_envs), self.obs_noise)
-        self._pending = torch.zeros_like(pend)
         # drop and success (DESIGN §6)
         dist = m["link_distance"]
         drop = dist.min(dim=-1).values > self.cfg["drop_threshold"]
@@ -605,6 +592,22 @@ class UniCrossEnv(BaseEnv):
         grasp_lifting = (self.elapsed_steps >= lift_after) if lift_after is not None else torch.zeros_like(drop)
         drop = drop & ((skill != 0) | grasp_lifting)
         self.ever_dropped = self.ever_dropped | drop
+        # advance the targets; after a drop they hold still: a lost object's pose no longer defines
+        # where the hand should go (Tracked hand targets would chase it; measured: the wrist
+        # reference jumped and slammed the hand at 11 m/s in a relocate episode without termination)
+        axis = F.task_axis(self.mode, cur, self.final_x_or)
+        init = self.init_rel.clone()
+        init.x_or = init.x_or + self.lift
+        new_t = F.update_targets(self.mode, cur, init, self.final_x_or, self.final_q_or, axis, self.motion,
+                                 skill=self.static_skill)
+        self.targets = new_t.where(pend & ~self.ever_dropped, self.targets)
+        self.axis = torch.where(p1, axis, self.axis)
+        self.prev_rel = cur.where(pend, self.prev_rel)
+        self.cur_rel = cur
+        if self._obs_noise_on:
+            self.obs_noise = torch.where(p1, self._draw_obs_noise(self.num_envs), self.obs_noise)
+        self._pending = torch.zeros_like(pend)
+        # success (DESIGN §6)
         contact = m["force"] > self.cfg["contact_force_threshold"]
         lifted = (m["obj_p"][:, 2] - self.obj_z0) > self.cfg["grasp"]["lift_success"]
         fx, fq = pose_mul(self.root_p, self.root_q, self.final_x_or, self.final_q_or)

@@ -22,7 +22,7 @@ def experts(tmp_path_factory):
         t = PPOTrainer(root / mode, skill, axis, overrides=dict(
             env=dict(num_envs=1, object_limit=1, reconfiguration_freq=0),
             collector=dict(total_frames=16, horizon=16), optim=dict(minibatch_size=16, mini_epochs=1),
-            logging=dict(eval_trials=0)), progress=False)
+            logging=dict(eval_trials=0, final_eval_trials=0)), progress=False)
         t.train(eval_at_ends=False)
         t.close()
     return root

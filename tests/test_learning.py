@@ -20,13 +20,20 @@ def test_grasp_audit_ranks_the_successful_grasp_first():
         assert ranked.index(lazy) > ranked.index("descend_close")
 
 
-@pytest.mark.parametrize("skill,axis,reference", [("relocate", None, "follow"), ("rotate", "z+", "oracle"),
-                                                  ("translate", "z-", "oracle")])
+@pytest.mark.parametrize("skill,axis,reference", [("rotate", "z+", "oracle"), ("translate", "z-", "oracle")])
 def test_in_hand_audits_rank_the_successful_reference_first(skill, axis, reference):
     rows = audit(skill, axis, limit=1, seeds=1, progress=False)
     assert rows[0].behaviour == reference and rows[0].success == 1.0
     assert all(r.success < 1.0 for r in rows[1:])
     assert all(r.min_total > -1e3 for r in rows)  # bounded (discounted, scaled) even for random actions
+
+
+@pytest.mark.slow
+@pytest.mark.xfail(strict=True, reason="open: relocate's Tracked targets pay staying put about as much as "
+                   "following, and rare drops cost the follower more (docs/reward_audit.md)")
+def test_relocate_audit_ranks_following_the_target_first():
+    rows = audit("relocate", limit=2, seeds=3, progress=False)
+    assert rows[0].behaviour == "follow"
 
 
 def test_paper_reward_pays_hovering_more_than_grasping():
@@ -110,3 +117,15 @@ def test_untrained_policy_acts_near_zero_and_normaliser_skips_nonfinite_rows():
     td["hand"][3, 0] = 0.0
     out = value(td.clone())
     assert torch.allclose(out["state_value"], value.value_norm(out["state_value_norm"]))
+
+
+def test_shipped_grasp_expert_lifts_a_held_out_object():
+    """The shipped expert (unicross/checkpoints/allegro/grasp.pt, by its shorthand) grasps and lifts
+    a test object it never trained on, under the paper's grasp protocol."""
+    from unicross import evaluation as E
+    from unicross.objects import get_object_set
+    policy, desc = E.resolve_policy("allegro/grasp", "allegro")
+    assert desc["skill"] == "grasp"
+    obj = get_object_set("test-wrappable", limit=1)[:1]
+    trials = E.run_protocol("grasp", policy, obj, trials_per_object=3, seed=0, progress=False)
+    assert sum(t["success"] for t in trials) >= 2

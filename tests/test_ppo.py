@@ -12,7 +12,7 @@ from unicross.rl.env import ManiSkillEnv
 from unicross.rl.ppo import PPOTrainer
 
 TINY = dict(env=dict(num_envs=1, object_limit=1), collector=dict(total_frames=96, horizon=16),
-            optim=dict(minibatch_size=8, mini_epochs=2), logging=dict(eval_trials=0, checkpoint_every=1))
+            optim=dict(minibatch_size=8, mini_epochs=2), logging=dict(eval_trials=0, final_eval_trials=0, checkpoint_every=1))
 
 
 @pytest.mark.parametrize("env_id,kw", [("UniCross-Grasp-v1", {}), ("UniCross-Relocate-v1", {}),
@@ -125,7 +125,7 @@ def test_ablation_row_is_one_train_and_one_eval(tmp_path):
     from unicross.cli import main
     run = tmp_path / "abl"
     assert main(["train", "--skill", "grasp", "--out", str(run), "--num-envs", "1", "--total-frames", "32",
-                 "--ablation", "no_target_obs", "--set", "collector.horizon=16", "--set", "logging.eval_trials=0",
+                 "--ablation", "no_target_obs", "--set", "collector.horizon=16", "--set", "logging.eval_trials=0", "--set", "logging.final_eval_trials=0",
                  "--set", "env.object_limit=1", "--set", "optim.minibatch_size=16"]) == 0
     out = tmp_path / "abl.json"
     assert main(["eval", "--policy", str(run / "checkpoint.pt"), "--protocol", "grasp", "--objects", "train-wrappable",
@@ -133,3 +133,24 @@ def test_ablation_row_is_one_train_and_one_eval(tmp_path):
     r = json.loads(out.read_text())
     assert r["policy"]["ablation"] == {"no_target_obs": True}
     assert main(["train", "--skill", "grasp", "--out", str(tmp_path / "x"), "--ablation", "no_fun"]) == 2
+
+
+def test_finished_run_evaluates_on_held_out_objects_and_exports(tmp_path):
+    """The end of a run: the paper's protocol on held-out objects (final_eval.json, unicross eval's
+    format), and `unicross export` ships the acting part, loadable as a policy."""
+    import json
+    from unicross.cli import main
+    from unicross.rl.policy_io import load_policy
+    over = dict(TINY, logging=dict(eval_trials=0, final_eval_trials=1, final_eval_limit=1, checkpoint_every=1))
+    t = PPOTrainer(tmp_path / "run", "grasp", overrides=over, progress=False)
+    summary = t.train()
+    t.close()
+    r = json.loads((tmp_path / "run" / "final_eval.json").read_text())
+    assert r["objects"] == "test" and r["summaries"]["grasp"]["n"] == 4 == summary["final"]["n"]
+    out = tmp_path / "ship" / "grasp.pt"
+    assert main(["export", str(tmp_path / "run"), "--out", str(out), "--command", "unicross train ...",
+                 "--eval", str(tmp_path / "run" / "final_eval.json")]) == 0
+    side = json.loads(out.with_suffix(".json").read_text())
+    assert side["commands"] == ["unicross train ..."] and side["evaluations"][0]["summaries"]["grasp"]["n"] == 4
+    policy, ck = load_policy(out)
+    assert "optim" not in ck and ck["skill"] == "grasp" and out.stat().st_size < 3e6

@@ -4,6 +4,7 @@
     unicross hands                        registered hands and their DoF
     unicross grasps --objects SET ...     synthesise a grasp-state dataset (scripted) and hold-test it
     unicross rollout --task ID ...        run random or zero actions and print per-term rewards
+    unicross export RUN --out FILE.pt     ship a run's policy (weights + normaliser) with a JSON sidecar
     unicross audit --skill SKILL          reward audit: returns of reference behaviours as PPO sees them
     unicross train --skill SKILL ...      train one expert with PPO (resumable)
     unicross distill --experts DIR ...    DAgger distillation of the ten experts into one student
@@ -182,6 +183,31 @@ def _cmd_train(args) -> int:
     for k, v in summary.items():
         print(f"{k}: " + ", ".join(f"{a}={b:.4g}" if isinstance(b, float) else f"{a}={b}" for a, b in v.items()))
     print(f"checkpoint: {trainer.run_dir / 'checkpoint.pt'} (iteration {trainer.iteration}, {trainer.frames} frames)")
+    return 0
+
+
+def _cmd_export(args) -> int:
+    """The acting part of a run's checkpoint (policy + observation statistics) and a JSON sidecar."""
+    import platform
+    import os
+    from unicross.rl.policy_io import export_policy
+    run = Path(args.run)
+    ckpt = run / "checkpoint.pt" if run.is_dir() else run
+    if not ckpt.exists():
+        raise FileNotFoundError(f"no checkpoint at {ckpt}")
+    sidecar = dict(commands=args.command or [], hardware=dict(machine=platform.machine(), cpus=os.cpu_count(),
+                                                               processor=platform.processor() or None,
+                                                               python=platform.python_version()))
+    import torch
+    ck = torch.load(ckpt, map_location="cpu", weights_only=False)
+    sidecar["train_wall_s"] = round(float(ck.get("wall_s", 0.0)), 1)
+    for f in args.eval or []:
+        e = json.loads(Path(f).read_text())
+        sidecar.setdefault("evaluations", []).append(dict(file=str(f), objects=e.get("objects"), limit=e.get("limit"),
+                                                          trials_per_object=e.get("trials_per_object"),
+                                                          seed=e.get("seed"), summaries=e.get("summaries")))
+    out = export_policy(ckpt, args.out, sidecar)
+    print(f"wrote {out} ({out.stat().st_size / 1e6:.2f} MB) and {out.with_suffix('.json')}")
     return 0
 
 
@@ -388,6 +414,12 @@ def main(argv=None) -> int:
     s.add_argument("--video", default=None, help="record the first trial and render it to this .mp4")
     s.add_argument("--out", default=None, help="JSON with every trial")
     s.set_defaults(fn=_cmd_chain)
+    s = sub.add_parser("export", help="ship a run: policy weights + normaliser only, with a JSON sidecar")
+    s.add_argument("run", help="run directory (or checkpoint.pt)")
+    s.add_argument("--out", required=True, help="e.g. unicross/checkpoints/allegro/grasp.pt")
+    s.add_argument("--command", action="append", help="a command that produced the run (repeat, in order)")
+    s.add_argument("--eval", action="append", help="an eval JSON written by `unicross eval` to record")
+    s.set_defaults(fn=_cmd_export)
     s = sub.add_parser("audit", help="reward audit: discounted, scaled returns of reference behaviours, ranked")
     s.add_argument("--skill", choices=["grasp", "relocate", "rotate", "translate"], default="grasp")
     s.add_argument("--axis", default=None, help="rotate: x+,x-,y+,y-,z+,z-; translate: z+,z-")

@@ -40,7 +40,7 @@ SKILL_ENV = {"grasp": "UniCross-Grasp-v1", "relocate": "UniCross-Relocate-v1", "
              "translate": "UniCross-Translate-v1"}
 DEFAULT_HORIZON = {"grasp": 64, "relocate": 64, "rotate": 8, "translate": 8}
 CKPT_NAME = "checkpoint.pt"
-CSV_FIELDS = ["iteration", "frames", "fps", "collect_s", "update_s", "reward_raw", "reward_scaled", "episodes",
+CSV_FIELDS = ["iteration", "frames", "wall_s", "fps", "collect_s", "update_s", "reward_raw", "reward_scaled", "episodes",
               "episode_return", "success_rate", "loss_objective", "loss_critic", "entropy", "kl", "clip_fraction",
               "ESS", "explained_variance", "value_clip_fraction", "grad_norm_actor", "grad_norm_critic", "lr",
               "value_mean", "value_std", "nonfinite"] + [f"reward_{t}" for t in REWARD_TERMS]
@@ -141,6 +141,8 @@ class PPOTrainer:
         self.optim = torch.optim.Adam(self.loss.parameters(), lr=cfg["optim"]["lr"])
         self.lr = cfg["optim"]["lr"]
         self.iteration, self.frames = 0, 0
+        self.wall_s = 0.0  # training wall-clock over all segments of the run (collection, updates, evaluations)
+        self._wall_mark = time.perf_counter()
         self.dims = dims
         if self.ckpt is not None:
             self._load_state(self.ckpt)
@@ -159,7 +161,7 @@ class PPOTrainer:
 
     def state(self) -> dict:
         return dict(policy=self.policy.state_dict(), value=self.value.state_dict(), optim=self.optim.state_dict(),
-                    iteration=self.iteration, frames=self.frames, lr=self.lr, config=self.cfg, skill=self.skill,
+                    iteration=self.iteration, frames=self.frames, lr=self.lr, wall_s=self._wall(), config=self.cfg, skill=self.skill,
                     axis=self.axis, hand=self.hand, env_id=self.env_id, env_kwargs=self.env_kwargs,
                     obs_dims=self.dims, n_act=self.n_act, git_commit=git_commit(),
                     rng=dict(torch=torch.get_rng_state(), numpy=np.random.get_state(), python=random.getstate()))
@@ -169,6 +171,7 @@ class PPOTrainer:
         self.value.load_state_dict(ck["value"])
         self.optim.load_state_dict(ck["optim"])
         self.iteration, self.frames, self.lr = ck["iteration"], ck["frames"], ck["lr"]
+        self.wall_s, self._wall_mark = float(ck.get("wall_s", 0.0)), time.perf_counter()
         for g in self.optim.param_groups:
             g["lr"] = self.lr
         torch.set_rng_state(ck["rng"]["torch"])
@@ -335,7 +338,7 @@ class PPOTrainer:
                 collector.update_policy_weights_()
                 terms = {k: float(data["next", "info", k].mean()) for k in data["next", "info"].keys()
                          if k.startswith("reward_")}
-                row = dict(iteration=self.iteration, frames=self.frames, fps=data.numel() / max(t_collect + t_update, 1e-9),
+                row = dict(iteration=self.iteration, frames=self.frames, wall_s=self._wall(), fps=data.numel() / max(t_collect + t_update, 1e-9),
                            collect_s=t_collect, update_s=t_update, reward_raw=reward_raw,
                            reward_scaled=reward_raw * self.cfg["gae"]["reward_scale"], **ep, **up, **terms)
                 self._log(row, writer)
@@ -358,11 +361,53 @@ class PPOTrainer:
         if evaluating and self.frames >= total:
             summary["end"] = self.evaluate()
             self._log_eval(summary["end"], writer=None)
+        if eval_at_ends and lc["final_eval_trials"] > 0 and self.frames >= total \
+                and not (self.run_dir / "final_eval.json").exists():
+            summary["final"] = self.final_evaluation()
         return summary
+
+    @torch.no_grad()
+    def final_evaluation(self) -> dict:
+        """The held-out evaluation of the finished expert: the paper's protocol for its skill on
+        ``logging.final_eval_objects`` (first ``final_eval_limit`` per group, ``final_eval_trials``
+        trials each, Wilson intervals), written as ``final_eval.json``/``.md`` in the run directory
+        in the format of ``unicross eval``."""
+        from unicross import evaluation as E
+        from unicross.objects import get_object_set
+        from unicross.rl.policy_io import act
+        lc = self.cfg["logging"]
+        objs = get_object_set(lc["final_eval_objects"], limit=lc["final_eval_limit"])
+        ablation = (self.cfg["env"].get("task_config") or {}).get("ablation")
+        self.policy.eval()
+        trials = E.run_protocol(self.skill, lambda obs, u: act(self.policy, obs), objs, hand=self.hand,
+                                trials_per_object=lc["final_eval_trials"], seed=0, progress=self.progress,
+                                axes=[self.axis] if self.axis else None, ablation=ablation)
+        self.policy.train()
+        summ = E.summarize(self.skill, trials)
+        label = f"{self.skill}{'_' + self.axis if self.axis else ''} expert"
+        result = dict(label=label, policy=dict(kind="checkpoint", path=str(self.run_dir / CKPT_NAME),
+                                               skill=self.skill, axis=self.axis, git_commit=git_commit()),
+                      objects=lc["final_eval_objects"], limit=lc["final_eval_limit"], hand=self.hand,
+                      trials_per_object=lc["final_eval_trials"], seed=0, disturb=False, original=False,
+                      randomize=False, frames=self.frames, summaries={self.skill: summ}, trials={self.skill: trials})
+        path = self.run_dir / "final_eval.json"
+        path.write_text(json.dumps(result, indent=1))
+        table = E.markdown_table({label: {self.skill: summ}})
+        path.with_suffix(".md").write_text(table + "\n")
+        print(f"held-out evaluation ({lc['final_eval_objects']}, {len(objs)} objects x {lc['final_eval_trials']} "
+              f"trials, paper protocol):\n{table}")
+        return dict(success=summ["sr"] / 100.0, ci95_low=summ["ci95"][0] / 100.0, ci95_high=summ["ci95"][1] / 100.0,
+                    n=summ["n"])
+
+    def _wall(self) -> float:
+        now = time.perf_counter()
+        self.wall_s += now - self._wall_mark
+        self._wall_mark = now
+        return self.wall_s
 
     def _log_eval(self, row: dict, writer) -> None:
         """Evaluation rows go to metrics.jsonl, eval.csv and TensorBoard (``eval/*``)."""
-        row = {"iteration": self.iteration, "frames": self.frames, **row}
+        row = {"iteration": self.iteration, "frames": self.frames, "wall_s": self._wall(), **row}
         self._log_json(row)
         path = self.run_dir / "eval.csv"
         new = not path.exists()

@@ -1,0 +1,64 @@
+"""Reward audit of every mode as a report: reference behaviours ranked by the return PPO sees
+(discounted by gamma, times reward_scale), with our coefficients and with the paper's.
+
+    python benchmarks/reward_audit.py --out docs/reward_audit.md [--limit 2 --seeds 3]
+
+Grasp and relocate use the training objects (first ``limit`` per group); rotate and translate run
+every axis/direction. See ``unicross/audit.py`` for the behaviours.
+"""
+from __future__ import annotations
+
+import argparse
+import time
+from pathlib import Path
+
+from unicross import formulation as F
+from unicross.audit import audit, behaviours, format_rows
+from unicross.config import load_preset
+
+MODES = [("grasp", None), ("relocate", None)] + [("rotate", a) for a in F.ROTATE_AXES] + \
+    [("translate", d) for d in F.TRANSLATE_DIRECTIONS]
+
+
+def main(argv=None) -> int:
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--out", default="docs/reward_audit.md")
+    p.add_argument("--limit", type=int, default=2)
+    p.add_argument("--seeds", type=int, default=3)
+    p.add_argument("--in-hand-seeds", type=int, default=1, help="episodes per object for rotate/translate (400/64 steps)")
+    p.add_argument("--modes", default=None, help="comma list like grasp,rotate:x+ (default: all ten)")
+    args = p.parse_args(argv)
+    modes = MODES
+    if args.modes:
+        want = [m.split(":") for m in args.modes.split(",")]
+        modes = [(m[0], m[1] if len(m) > 1 else None) for m in want]
+    lines = ["# Reward audit", "",
+             "Reference behaviours per mode, ranked by their return as PPO sees it (each term discounted by "
+             "gamma and multiplied by reward_scale; `configs/ppo.yaml` training env). `raw return` is the "
+             "undiscounted, unscaled sum. Made by `python benchmarks/reward_audit.py "
+             f"--limit {args.limit} --seeds {args.seeds} --in-hand-seeds {args.in_hand_seeds}`.", ""]
+    verdict = []
+    for skill, axis in modes:
+        seeds = args.seeds if skill in ("grasp", "relocate") else args.in_hand_seeds
+        limit = args.limit if skill in ("grasp", "relocate") else 1
+        ref = next(iter(behaviours(skill)))
+        for label, preset in (("ours", None), ("paper", "paper_reward")):
+            t0 = time.time()
+            rows = audit(skill, axis, limit=limit, seeds=seeds, progress=False,
+                         ppo_overrides=load_preset(preset) if preset else None)
+            rank = 1 + [r.behaviour for r in rows].index(ref)
+            title = f"{skill}{' ' + axis if axis else ''}"
+            lines += [f"## {title}: {label} coefficients (reference `{ref}` ranks {rank}/{len(rows)}; "
+                      f"{time.time() - t0:.0f} s)", "", format_rows(rows), ""]
+            verdict.append(f"| {title} | {label} | {rank} of {len(rows)} | {rows[0].behaviour} |")
+            print(f"{title} ({label}): reference {ref} ranks {rank}/{len(rows)}", flush=True)
+    summary = ["## Summary", "", "| mode | coefficients | rank of the successful reference | first |",
+               "|---|---|---|---|"] + verdict + [""]
+    Path(args.out).parent.mkdir(parents=True, exist_ok=True)
+    Path(args.out).write_text("\n".join(lines[:5] + summary + lines[5:]) + "\n")
+    print(f"wrote {args.out}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
