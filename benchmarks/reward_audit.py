@@ -55,7 +55,7 @@ def main(argv=None) -> int:
     summary = ["## Summary", "", "| mode | coefficients | rank of the successful reference | first |",
                "|---|---|---|---|"] + verdict + [""]
     Path(args.out).parent.mkdir(parents=True, exist_ok=True)
-    Path(args.out).write_text("\n".join(lines[:5] + summary + lines[5:]) + "\n")
+    Path(args.out).write_text("\n".join(lines[:4] + summary + lines[4:]) + "\n")
     print(f"wrote {args.out}")
     return 0
 
