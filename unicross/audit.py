@@ -39,8 +39,6 @@ from unicross import formulation as F
 from unicross.config import load_config
 
 from unicross.rewards import TERMS
-SKILL_ENV = {"grasp": "UniCross-Grasp-v1", "relocate": "UniCross-Relocate-v1", "rotate": "UniCross-Rotate-v1",
-             "translate": "UniCross-Translate-v1"}
 
 
 # ----------------------------------------------------------------------------- reference behaviours
@@ -154,7 +152,7 @@ def audit(skill: str = "grasp", axis: Optional[str] = None, objects: Optional[st
     import unicross  # noqa: F401  (registers the tasks)
     from tqdm import tqdm
     from unicross.objects import get_object_set
-    from unicross.rl.ppo import env_kwargs_for
+    from unicross.rl.ppo import SKILL_ENV, env_kwargs_for
     cfg = load_config("ppo", ppo_overrides)
     gamma, scale = cfg["gae"]["gamma"], cfg["gae"]["reward_scale"]
     kw = env_kwargs_for(skill, axis, hand, cfg["env"])

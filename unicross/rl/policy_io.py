@@ -12,7 +12,7 @@ from unicross.rl.models import make_models
 
 SHIPPED_DIR = Path(__file__).resolve().parent.parent / "checkpoints"
 SHIPPED_KEYS = ("policy", "obs_dims", "n_act", "config", "skill", "axis", "hand", "env_id", "env_kwargs",
-                "iteration", "frames", "git_commit")
+                "iteration", "frames", "git_commit", "commits")
 
 
 def resolve_checkpoint(spec) -> Path:
@@ -38,7 +38,7 @@ def export_policy(run_checkpoint, out, sidecar: dict) -> Path:
     out = Path(out)
     out.parent.mkdir(parents=True, exist_ok=True)
     torch.save(small, out)
-    facts = {k: small[k] for k in ("skill", "axis", "hand", "iteration", "frames", "git_commit") if k in small}
+    facts = {k: small[k] for k in ("skill", "axis", "hand", "iteration", "frames", "git_commit", "commits") if k in small}
     out.with_suffix(".json").write_text(json.dumps({**facts, **sidecar}, indent=1) + "\n")
     return out
 

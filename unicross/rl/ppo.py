@@ -106,6 +106,9 @@ class PPOTrainer:
         from unicross.robots.hand import load_hand
         load_hand(hand)  # validates
         self.skill, self.axis, self.hand, self.cfg = skill, axis, hand, cfg
+        # the code this segment runs (read once: HEAD may move while a long run trains)
+        self.commit = git_commit()
+        self.commits = list((self.ckpt or {}).get("commits", [])) + [self.commit]
         self.env_id = SKILL_ENV[skill] if skill in SKILL_ENV else None
         if self.env_id is None:
             raise ValueError(f"unknown skill {skill!r}; valid skills: {list(SKILL_ENV)}")
@@ -163,7 +166,7 @@ class PPOTrainer:
         return dict(policy=self.policy.state_dict(), value=self.value.state_dict(), optim=self.optim.state_dict(),
                     iteration=self.iteration, frames=self.frames, lr=self.lr, wall_s=self._wall(), config=self.cfg, skill=self.skill,
                     axis=self.axis, hand=self.hand, env_id=self.env_id, env_kwargs=self.env_kwargs,
-                    obs_dims=self.dims, n_act=self.n_act, git_commit=git_commit(),
+                    obs_dims=self.dims, n_act=self.n_act, git_commit=self.commit, commits=self.commits,
                     rng=dict(torch=torch.get_rng_state(), numpy=np.random.get_state(), python=random.getstate()))
 
     def _load_state(self, ck: dict):
@@ -309,7 +312,7 @@ class PPOTrainer:
         remaining = max(0, total - self.frames)
         self.run_dir.mkdir(parents=True, exist_ok=True)
         (self.run_dir / "config.json").write_text(json.dumps(dict(config=self.cfg, skill=self.skill, axis=self.axis,
-                                                                  hand=self.hand, git_commit=git_commit()), indent=1))
+                                                                  hand=self.hand, git_commit=self.commit), indent=1))
         summary = {}
         lc = self.cfg["logging"]
         evaluating = eval_at_ends and lc["eval_trials"] > 0
@@ -386,7 +389,7 @@ class PPOTrainer:
         summ = E.summarize(self.skill, trials)
         label = f"{self.skill}{'_' + self.axis if self.axis else ''} expert"
         result = dict(label=label, policy=dict(kind="checkpoint", path=str(self.run_dir / CKPT_NAME),
-                                               skill=self.skill, axis=self.axis, git_commit=git_commit()),
+                                               skill=self.skill, axis=self.axis, git_commit=self.commit),
                       objects=lc["final_eval_objects"], limit=lc["final_eval_limit"], hand=self.hand,
                       trials_per_object=lc["final_eval_trials"], seed=0, disturb=False, original=False,
                       randomize=False, frames=self.frames, summaries={self.skill: summ}, trials={self.skill: trials})
