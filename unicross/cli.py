@@ -212,15 +212,16 @@ def _cmd_export(args) -> int:
 
 
 def _cmd_audit(args) -> int:
-    from unicross.audit import audit, format_rows
+    from unicross.audit import audit, behaviours, format_rows
     overrides = overrides_from(args)
     rows = audit(args.skill, args.axis, args.objects, args.limit, args.seeds, args.hand,
                  ppo_overrides=overrides or None, only=args.only.split(",") if args.only else None)
     table = format_rows(rows)
     print(table)
-    ref = next(iter(__import__("unicross.audit", fromlist=["behaviours"]).behaviours(args.skill)))
-    print(f"successful reference ({ref}) ranks {1 + [r.behaviour for r in rows].index(ref)} of {len(rows)}"
-          if ref in [r.behaviour for r in rows] else "")
+    ranked = [r.behaviour for r in rows]
+    ref = next(iter(behaviours(args.skill)))  # each skill lists its successful reference first
+    if ref in ranked:
+        print(f"successful reference ({ref}) ranks {1 + ranked.index(ref)} of {len(rows)}")
     if args.out:
         Path(args.out).parent.mkdir(parents=True, exist_ok=True)
         Path(args.out).write_text(json.dumps([r.__dict__ for r in rows], indent=1))

@@ -3,7 +3,7 @@
 ``r = r_goal + r_track + r_reg`` with
   r_goal  = contact + motion (+ success: ours, a per-step bonus while the mode's success holds;
             0 in the paper, see configs/reward.yaml)
-  r_track = Σ w · error over the six relational poses (each error saturates at ``track.max_error``)
+  r_track = Σ w · error over the six relational poses (position errors saturate at ``track.max_pos_error``)
   r_reg   = pose + wrist_velocity + energy + drop
 
 ``TERMS`` names every term once; the task sums exactly these and logs each as ``reward_<name>``.
@@ -39,14 +39,15 @@ def motion_reward(speed_along_axis: torch.Tensor, cap: torch.Tensor, w_p: torch.
 
 
 def tracking_reward(cur: Relational, tgt: Relational, w_pos: torch.Tensor, w_rot: torch.Tensor,
-                    max_pos: float = float("inf"), max_rot: float = float("inf")) -> torch.Tensor:
-    """Σ w_pos·min(||x - x̂||, max_pos)² + w_rot·min(A(q, q̂), max_rot) over the three relational
-    poses (o in h, o in r, h in r); ``w_pos``/``w_rot`` are [3] weights in that order. The
-    saturation bounds the term when an object is lost (a dropped object can roll away forever)."""
+                    max_pos: float = float("inf")) -> torch.Tensor:
+    """Σ w_pos·min(||x - x̂||, max_pos)² + w_rot·A(q, q̂) over the three relational poses (o in h,
+    o in r, h in r); ``w_pos``/``w_rot`` are [3] weights in that order. The position saturation
+    bounds the term when an object is lost (a dropped object can roll away for ever); angles are
+    bounded by π already."""
     xc, qc = cur.poses()
     xt, qt = tgt.poses()
     pos = torch.linalg.norm(xc - xt, dim=-1).clamp(max=max_pos) ** 2
-    return (pos * w_pos).sum(-1) + (quat_angle(qc, qt).clamp(max=max_rot) * w_rot).sum(-1)
+    return (pos * w_pos).sum(-1) + (quat_angle(qc, qt) * w_rot).sum(-1)
 
 
 def success_reward(success: torch.Tensor, w_success: torch.Tensor) -> torch.Tensor:
@@ -54,7 +55,7 @@ def success_reward(success: torch.Tensor, w_success: torch.Tensor) -> torch.Tens
     return w_success * success.float()
 
 
-def pose_reward(finger_q: torch.Tensor, finger_q0: torch.Tensor, w_pose) -> torch.Tensor:
+def pose_reward(finger_q: torch.Tensor, finger_q0: torch.Tensor, w_pose: float) -> torch.Tensor:
     """w_pose · Σ (q_i - q_i,0)² over finger joints."""
     return w_pose * ((finger_q - finger_q0) ** 2).sum(-1)
 
@@ -83,9 +84,8 @@ class RewardTerms:
         self.w_p = per_mode(lambda s: cfg["motion"][s])
         self.max_distance = float(cfg["contact_max_distance"])
         self.w_success = per_mode(lambda s: cfg["success"][s])
-        self.w_pose = per_mode(lambda s: cfg["pose"][s])
         t = cfg["track"]
-        self.max_pos, self.max_rot = float(t["max_pos_error"]), float(t["max_rot_error"])
+        self.max_pos = float(t["max_pos_error"])
         self.track_pos = torch.tensor([t[TRACK_WEIGHTS[s]] for s in ("x_oh", "x_or", "x_hr")], device=device)
         self.track_rot = torch.tensor([t[TRACK_WEIGHTS[s]] for s in ("q_oh", "q_or", "q_hr")], device=device)
         self.reg = dict(cfg["reg"])
@@ -99,8 +99,8 @@ class RewardTerms:
             motion=motion_reward(m["speed_along_axis"], m["speed_cap"], self.w_p[mode]),
             success=success_reward(m["success"], self.w_success[mode]),
             track=tracking_reward(m["relational"], m["reward_targets"], self.track_pos, self.track_rot,
-                                  self.max_pos, self.max_rot),
-            pose=pose_reward(m["finger_qpos"], m["finger_qpos0"], self.w_pose[mode]),
+                                  self.max_pos),
+            pose=pose_reward(m["finger_qpos"], m["finger_qpos0"], self.reg["w_pose"]),
             wrist_velocity=wrist_velocity_reward(m["hand_lin_vel"], m["hand_ang_vel"],
                                                  self.reg["w_vel"], self.reg["w_ang"]),
             energy=energy_reward(m["finger_torque"], self.reg["w_tau"]),

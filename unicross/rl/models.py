@@ -33,6 +33,16 @@ def mlp(inp: int, hidden: Sequence[int], out: int | None, act=nn.ELU) -> nn.Sequ
     return nn.Sequential(*layers)
 
 
+@torch.no_grad()
+def merge_moments(mean: torch.Tensor, var: torch.Tensor, count: torch.Tensor, x: torch.Tensor) -> None:
+    """Fold the rows of ``x`` [n, ...] into running ``mean``/``var`` (in place) held over ``count``
+    earlier rows (the caller adds n to its count)."""
+    n = x.shape[0]
+    delta, tot = x.mean(0) - mean, count + n
+    var.copy_((var * count + x.var(0, unbiased=False) * n + delta ** 2 * count * n / tot) / tot)
+    mean += delta * n / tot
+
+
 class ObsNormalizer(nn.Module):
     """Running mean/variance per observation group; ``update`` is called by the trainer on each
     collected batch (after the update that used the previous statistics)."""
@@ -56,13 +66,7 @@ class ObsNormalizer(nn.Module):
         if n == 0:
             return 0
         for k in self.keys:
-            x = rows[k][finite]
-            mean, var = x.mean(0), x.var(0, unbiased=False)
-            m, v, c = getattr(self, f"{k}_mean"), getattr(self, f"{k}_var"), self.count
-            delta = mean - m
-            tot = c + n
-            m += delta * n / tot
-            v.copy_((v * c + var * n + delta ** 2 * c * n / tot) / tot)
+            merge_moments(getattr(self, f"{k}_mean"), getattr(self, f"{k}_var"), self.count, rows[k][finite])
         self.count += n
         return n
 
@@ -102,11 +106,8 @@ class ValueNormalizer(nn.Module):
         x = x[torch.isfinite(x)]
         if x.numel() == 0:
             return
-        n, mean, var = x.numel(), x.mean(), x.var(unbiased=False)
-        delta, tot = mean - self.mean, self.count + x.numel()
-        self.var.copy_((self.var * self.count + var * n + delta ** 2 * self.count * n / tot) / tot)
-        self.mean += delta * n / tot
-        self.count += n
+        merge_moments(self.mean, self.var, self.count, x)
+        self.count += x.numel()
 
     def std(self) -> torch.Tensor:
         return torch.sqrt(self.var + 1e-8)

@@ -25,7 +25,6 @@ from tensordict import TensorDict
 from torchrl.collectors import Collector
 from torchrl.data import LazyTensorStorage, TensorDictReplayBuffer
 from torchrl.data.replay_buffers.samplers import SamplerWithoutReplacement
-from torchrl.envs.utils import ExplorationType, set_exploration_type
 from torchrl.objectives import ClipPPOLoss
 from torchrl.objectives.value import GAE
 from tqdm import tqdm
@@ -144,6 +143,7 @@ class PPOTrainer:
         self.optim = torch.optim.Adam(self.loss.parameters(), lr=cfg["optim"]["lr"])
         self.lr = cfg["optim"]["lr"]
         self.iteration, self.frames = 0, 0
+        self._writer = None  # TensorBoard, open while train() runs
         self.wall_s = 0.0  # training wall-clock over all segments of the run (collection, updates, evaluations)
         self._wall_mark = time.perf_counter()
         self.dims = dims
@@ -187,25 +187,30 @@ class PPOTrainer:
 
     # ------------------------------------------------------------------ evaluation
     @torch.no_grad()
-    def evaluate(self) -> dict:
-        """The paper's protocol for this expert's skill (and axis), deterministic actions, on a
-        fixed held-out set (``logging.eval_objects``, first ``eval_limit`` objects per group,
-        ``eval_trials`` trials each) with fixed seeds: every evaluation of a run sees the same
-        objects and starts, in its own in-process env (not the training workers)."""
+    def _protocol(self, objects: str, limit, trials_per_object: int, seed: int, progress: bool = False):
+        """(trials, summary) of the paper's protocol for this expert's skill (and axis) on the first
+        ``limit`` objects per group of ``objects``, deterministic actions, in its own in-process env
+        (not the training workers), with the run's ablation switches."""
         from unicross import evaluation as E
         from unicross.objects import get_object_set
         from unicross.rl.policy_io import act
-        lc = self.cfg["logging"]
-        objs = get_object_set(lc["eval_objects"], limit=lc["eval_limit"])
+        objs = get_object_set(objects, limit=limit)
         self.policy.eval()
         try:
             trials = E.run_protocol(self.skill, lambda obs, u: act(self.policy, obs), objs, hand=self.hand,
-                                    trials_per_object=lc["eval_trials"], seed=lc["eval_seed"], progress=False,
+                                    trials_per_object=trials_per_object, seed=seed, progress=progress,
                                     axes=[self.axis] if self.axis else None,
                                     ablation=(self.cfg["env"].get("task_config") or {}).get("ablation"))
         finally:
             self.policy.train()
-        summ = E.summarize(self.skill, trials)
+        return trials, E.summarize(self.skill, trials)
+
+    def evaluate(self) -> dict:
+        """The in-training evaluation: a fixed held-out set (``logging.eval_objects``, first
+        ``eval_limit`` objects per group, ``eval_trials`` trials each) with fixed seeds, so every
+        evaluation of a run sees the same objects and starts."""
+        lc = self.cfg["logging"]
+        _, summ = self._protocol(lc["eval_objects"], lc["eval_limit"], lc["eval_trials"], lc["eval_seed"])
         out = dict(eval_success=summ["sr"] / 100.0, eval_ci95_low=summ["ci95"][0] / 100.0,
                    eval_ci95_high=summ["ci95"][1] / 100.0, eval_n=summ["n"])
         for k in ("pe_cm", "ae_rad", "rot_rad", "trans_cm"):
@@ -308,6 +313,17 @@ class PPOTrainer:
             g["lr"] = self.lr
 
     def train(self, max_iterations: Optional[int] = None, eval_at_ends: bool = True) -> dict:
+        """Collect and update until ``collector.total_frames`` (or ``max_iterations`` more
+        iterations), with the held-out evaluations of ``logging``; returns their summaries."""
+        self._writer = self._tb()
+        try:
+            return self._train(max_iterations, eval_at_ends)
+        finally:
+            if self._writer is not None:
+                self._writer.close()
+            self._writer = None
+
+    def _train(self, max_iterations: Optional[int], eval_at_ends: bool) -> dict:
         total = self.cfg["collector"]["total_frames"]
         remaining = max(0, total - self.frames)
         self.run_dir.mkdir(parents=True, exist_ok=True)
@@ -318,12 +334,11 @@ class PPOTrainer:
         evaluating = eval_at_ends and lc["eval_trials"] > 0
         if evaluating and self.iteration == 0:
             summary["start"] = self.evaluate()
-            self._log_eval(summary["start"], writer=None)
+            self._log_eval(summary["start"])
         if remaining == 0:
             return summary
         collector = Collector(self.env, self.policy, frames_per_batch=self.frames_per_batch, total_frames=remaining,
                               device=self.device, auto_register_policy_transforms=False)
-        writer = self._tb()
         bar = tqdm(total=total, initial=self.frames, unit="frame", desc=f"ppo {self.skill}", disable=not self.progress)
         t_last = time.perf_counter()
         done_iters = 0
@@ -344,13 +359,13 @@ class PPOTrainer:
                 row = dict(iteration=self.iteration, frames=self.frames, wall_s=self._wall(), fps=data.numel() / max(t_collect + t_update, 1e-9),
                            collect_s=t_collect, update_s=t_update, reward_raw=reward_raw,
                            reward_scaled=reward_raw * self.cfg["gae"]["reward_scale"], **ep, **up, **terms)
-                self._log(row, writer)
+                self._log(row)
                 bar.update(data.numel())
                 bar.set_postfix(ret=f"{row.get('episode_return', float('nan')):.2f}", succ=f"{row.get('success_rate', float('nan')):.2f}")
                 if self.iteration % lc["checkpoint_every"] == 0:
                     self.save()
                 if evaluating and lc["eval_every"] and self.iteration % lc["eval_every"] == 0:
-                    self._log_eval(self.evaluate(), writer)
+                    self._log_eval(self.evaluate())
                 done_iters += 1
                 t_last = time.perf_counter()
                 if max_iterations is not None and done_iters >= max_iterations:
@@ -359,34 +374,23 @@ class PPOTrainer:
             self.save()
             bar.close()
             collector.shutdown(close_env=False)
-            if writer is not None:
-                writer.close()
         if evaluating and self.frames >= total:
             summary["end"] = self.evaluate()
-            self._log_eval(summary["end"], writer=None)
+            self._log_eval(summary["end"])
         if eval_at_ends and lc["final_eval_trials"] > 0 and self.frames >= total \
                 and not (self.run_dir / "final_eval.json").exists():
             summary["final"] = self.final_evaluation()
         return summary
 
-    @torch.no_grad()
     def final_evaluation(self) -> dict:
         """The held-out evaluation of the finished expert: the paper's protocol for its skill on
         ``logging.final_eval_objects`` (first ``final_eval_limit`` per group, ``final_eval_trials``
         trials each, Wilson intervals), written as ``final_eval.json``/``.md`` in the run directory
         in the format of ``unicross eval``."""
         from unicross import evaluation as E
-        from unicross.objects import get_object_set
-        from unicross.rl.policy_io import act
         lc = self.cfg["logging"]
-        objs = get_object_set(lc["final_eval_objects"], limit=lc["final_eval_limit"])
-        ablation = (self.cfg["env"].get("task_config") or {}).get("ablation")
-        self.policy.eval()
-        trials = E.run_protocol(self.skill, lambda obs, u: act(self.policy, obs), objs, hand=self.hand,
-                                trials_per_object=lc["final_eval_trials"], seed=0, progress=self.progress,
-                                axes=[self.axis] if self.axis else None, ablation=ablation)
-        self.policy.train()
-        summ = E.summarize(self.skill, trials)
+        trials, summ = self._protocol(lc["final_eval_objects"], lc["final_eval_limit"], lc["final_eval_trials"],
+                                      seed=0, progress=self.progress)
         label = f"{self.skill}{'_' + self.axis if self.axis else ''} expert"
         result = dict(label=label, policy=dict(kind="checkpoint", path=str(self.run_dir / CKPT_NAME),
                                                skill=self.skill, axis=self.axis, git_commit=self.commit),
@@ -397,8 +401,8 @@ class PPOTrainer:
         path.write_text(json.dumps(result, indent=1))
         table = E.markdown_table({label: {self.skill: summ}})
         path.with_suffix(".md").write_text(table + "\n")
-        print(f"held-out evaluation ({lc['final_eval_objects']}, {len(objs)} objects x {lc['final_eval_trials']} "
-              f"trials, paper protocol):\n{table}")
+        print(f"held-out evaluation ({lc['final_eval_objects']}, first {lc['final_eval_limit']} objects per group x "
+              f"{lc['final_eval_trials']} trials, paper protocol):\n{table}")
         return dict(success=summ["sr"] / 100.0, ci95_low=summ["ci95"][0] / 100.0, ci95_high=summ["ci95"][1] / 100.0,
                     n=summ["n"])
 
@@ -408,25 +412,15 @@ class PPOTrainer:
         self._wall_mark = now
         return self.wall_s
 
-    def _log_eval(self, row: dict, writer) -> None:
+    def _log_eval(self, row: dict) -> None:
         """Evaluation rows go to metrics.jsonl, eval.csv and TensorBoard (``eval/*``)."""
         row = {"iteration": self.iteration, "frames": self.frames, "wall_s": self._wall(), **row}
         self._log_json(row)
-        path = self.run_dir / "eval.csv"
-        new = not path.exists()
-        with open(path, "a", newline="") as f:
-            w = csv.DictWriter(f, fieldnames=list(row))
-            if new:
-                w.writeheader()
-            w.writerow(row)
-        own = writer is None
-        writer = writer or self._tb()
-        if writer is not None:
+        self._append_csv("eval.csv", row, list(row))
+        if self._writer is not None:
             for k, v in row.items():
                 if k not in ("iteration", "frames"):
-                    writer.add_scalar(f"eval/{k}", v, self.frames)
-            if own:
-                writer.close()
+                    self._writer.add_scalar(f"eval/{k}", v, self.frames)
 
     # ------------------------------------------------------------------ logging
     def _tb(self):
@@ -440,19 +434,22 @@ class PPOTrainer:
         with open(self.run_dir / "metrics.jsonl", "a") as f:
             f.write(json.dumps(row) + "\n")
 
-    def _log(self, row: dict, writer):
-        self._log_json(row)
-        path = self.run_dir / "metrics.csv"
+    def _append_csv(self, name: str, row: dict, fields) -> None:
+        path = self.run_dir / name
         new = not path.exists()
         with open(path, "a", newline="") as f:
-            w = csv.DictWriter(f, fieldnames=CSV_FIELDS, extrasaction="ignore")
+            w = csv.DictWriter(f, fieldnames=fields, extrasaction="ignore")
             if new:
                 w.writeheader()
             w.writerow(row)
-        if writer is not None:
+
+    def _log(self, row: dict):
+        self._log_json(row)
+        self._append_csv("metrics.csv", row, CSV_FIELDS)
+        if self._writer is not None:
             for k, v in row.items():
                 if k not in ("iteration", "frames") and isinstance(v, (int, float)):
-                    writer.add_scalar(k, v, self.frames)
+                    self._writer.add_scalar(k, v, self.frames)
 
     def close(self):
         try:
