@@ -13,6 +13,7 @@ Per control step (``step``):
 """
 from __future__ import annotations
 
+import gc
 import math
 from typing import Any, Dict, Optional, Sequence
 
@@ -39,6 +40,23 @@ from unicross.objects import resolve_objects
 from unicross.rewards import TERMS as REWARD_TERMS, RewardTerms
 from unicross.robots.hand import HAND_FRAME_LINK, HandSpec, load_hand, register_hand_agent
 from unicross.sensing import HandObjectSensor
+
+_HEAP_FROZEN = False
+
+
+def _freeze_heap_once() -> None:
+    """``gc.freeze()`` once per process, after the first task is built: the objects alive then
+    (imported libraries, the first scene) are never scanned by the cycle collector again.
+    ManiSkill's ``_clear`` runs a full ``gc.collect()`` at every reconfiguration; with the heap
+    frozen it costs ~2 µs instead of ~0.25 s (measured: reset with a scene rebuild 0.27 s -> 0.02 s
+    on a CPU), which matters when CPU workers rebuild the scene every few episodes. Later scenes
+    stay collectable; what the first scene holds in reference cycles is kept for the process."""
+    global _HEAP_FROZEN
+    if not _HEAP_FROZEN:
+        gc.collect()
+        gc.freeze()
+        _HEAP_FROZEN = True
+
 
 CATEGORY_ID = {"wrappable": 0, "elongated": 1}
 MODE_CATEGORIES = {"grasp": ("wrappable", "elongated"), "relocate": ("wrappable", "elongated"),
@@ -155,6 +173,7 @@ class UniCrossEnv(BaseEnv):
         n = self.hand_spec.dof
         self.single_action_space = spaces.Box(-1.0, 1.0, (n,), dtype=np.float32)
         self.action_space = batch_space(self.single_action_space, self.num_envs)
+        _freeze_heap_once()
 
     # ------------------------------------------------------------------ configuration
     @property

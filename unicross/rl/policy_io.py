@@ -4,9 +4,8 @@ from __future__ import annotations
 from pathlib import Path
 
 import torch
-from torchrl.envs.utils import ExplorationType, set_exploration_type
 
-from unicross.rl.env import obs_to_td
+from unicross.rl.collector import split_obs
 from unicross.rl.models import make_models
 
 
@@ -60,7 +59,10 @@ def load_policy(path, device="cpu"):
 
 @torch.no_grad()
 def act(policy, obs: dict, deterministic: bool = True) -> torch.Tensor:
-    """Action [N, A] of ``policy`` for a UniCross ``state_dict`` observation."""
-    td = obs_to_td(obs)
-    with set_exploration_type(ExplorationType.DETERMINISTIC if deterministic else ExplorationType.RANDOM):
-        return policy(td)["action"].clamp(-1.0, 1.0)
+    """Action [N, A] of ``policy`` (a :func:`make_models` actor) for a UniCross ``state_dict``
+    observation: the Gaussian's mean, or a sample of it, clipped to [-1, 1]. Calls the network
+    directly (the TensorDict actor costs ~2 ms per call on a CPU, the network ~0.3 ms)."""
+    loc, scale = policy.module[0].module(*split_obs(obs))
+    if not deterministic:
+        loc = loc + scale * torch.randn_like(loc)
+    return loc.clamp(-1.0, 1.0)

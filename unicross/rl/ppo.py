@@ -1,7 +1,10 @@
 """PPO for one UniCross expert with TorchRL building blocks.
 
-    Collector -> GAE -> TensorDict replay buffer (mini-batches) -> ClipPPOLoss -> Adam
+    LeanCollector -> GAE -> TensorDict replay buffer (mini-batches) -> ClipPPOLoss -> Adam
     (+ KL-adaptive learning rate, grad-norm clipping, running observation normalisation)
+
+On the CPU the collector runs one env per worker process with the actor inside the worker
+(:mod:`unicross.rl.collector`); the main process does GAE and the update.
 
 Checkpoints (weights, optimiser, iteration, frames, learning rate, RNG states, config, git commit)
 are written atomically every ``logging.checkpoint_every`` iterations and on exit; ``resume=True``
@@ -22,8 +25,7 @@ from typing import Optional
 import numpy as np
 import torch
 from tensordict import TensorDict
-from torchrl.collectors import Collector
-from torchrl.data import LazyTensorStorage, TensorDictReplayBuffer
+from torchrl.data import Bounded, LazyTensorStorage, TensorDictReplayBuffer
 from torchrl.data.replay_buffers.samplers import SamplerWithoutReplacement
 from torchrl.objectives import ClipPPOLoss
 from torchrl.objectives.value import GAE
@@ -32,13 +34,34 @@ from tqdm import tqdm
 from unicross import formulation as F
 from unicross.config import deep_merge, load_config
 from unicross.rewards import TERMS as REWARD_TERMS
-from unicross.rl.env import make_env
-from unicross.rl.models import OBS_KEYS, make_models, obs_dims_from_spec
+from unicross.rl.collector import LeanCollector
+from unicross.rl.models import OBS_KEYS, make_models
 
 SKILL_ENV = {"grasp": "UniCross-Grasp-v1", "relocate": "UniCross-Relocate-v1", "rotate": "UniCross-Rotate-v1",
              "translate": "UniCross-Translate-v1"}
 DEFAULT_HORIZON = {"grasp": 64, "relocate": 64, "rotate": 8, "translate": 8}
 CKPT_NAME = "checkpoint.pt"
+
+
+def resolve_num_envs(num_envs, backend: str) -> int:
+    """``env.num_envs``: null means one env per usable CPU core (CPU backend)."""
+    if num_envs is None:
+        if backend != "physx_cpu":
+            raise ValueError("env.num_envs must be set for the GPU backend (e.g. 4096)")
+        return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+    if int(num_envs) < 1:
+        raise ValueError(f"env.num_envs must be >= 1, got {num_envs}")
+    return int(num_envs)
+
+
+def resolve_horizon(collector_cfg: dict, skill: str, num_envs: int) -> int:
+    """Steps per env per iteration: ``collector.horizon`` if set; else ``frames_per_batch`` split
+    over the envs (rounded up); else the paper's horizon of the skill."""
+    if collector_cfg.get("horizon"):
+        return int(collector_cfg["horizon"])
+    if collector_cfg.get("frames_per_batch"):
+        return -(-int(collector_cfg["frames_per_batch"]) // num_envs)
+    return DEFAULT_HORIZON[skill]
 CSV_FIELDS = ["iteration", "frames", "wall_s", "fps", "collect_s", "update_s", "reward_raw", "reward_scaled", "episodes",
               "episode_return", "success_rate", "loss_objective", "loss_critic", "entropy", "kl", "clip_fraction",
               "ESS", "explained_variance", "value_clip_fraction", "grad_norm_actor", "grad_norm_critic", "lr",
@@ -113,17 +136,20 @@ class PPOTrainer:
             raise ValueError(f"unknown skill {skill!r}; valid skills: {list(SKILL_ENV)}")
         self.env_kwargs = env_kwargs_for(skill, axis, hand, cfg["env"])
         self.progress = progress
-        self.horizon = cfg["collector"]["horizon"] or DEFAULT_HORIZON[skill]
         self._seed_everything(cfg["seed"])
         ec = cfg["env"]
-        if ec["backend"] == "physx_cpu":  # leave the cores to the env worker processes
-            torch.set_num_threads(max(1, (os.cpu_count() or 1) - ec["num_envs"]))
-        self.env = make_env(self.env_id, self.env_kwargs, ec["num_envs"], ec["backend"])
-        self.env.set_seed(cfg["seed"])
-        self.device = self.env.device
-        dims = obs_dims_from_spec(self.env.observation_spec)
-        self.n_act = self.env.action_spec.shape[-1]
-        self.policy, self.value, self.norm = make_models(dims, self.n_act, self.env.action_spec, cfg["model"])
+        num_envs = resolve_num_envs(ec["num_envs"], ec["backend"])
+        self.horizon = resolve_horizon(cfg["collector"], skill, num_envs)
+        # envs of a resumed run start from new seeds (not a replay of the first iteration's starts)
+        start_iteration = int((self.ckpt or {}).get("iteration", 0))
+        self.collector = LeanCollector(self.env_id, self.env_kwargs, num_envs, self.horizon,
+                                       seed=cfg["seed"] + 1000 * start_iteration, backend=ec["backend"])
+        if ec["backend"] == "physx_cpu":  # workers and the update take turns: the update gets every core
+            torch.set_num_threads(os.cpu_count() or 1)
+        self.device = self.collector.device
+        dims, self.n_act = self.collector.dims, self.collector.n_act
+        self.policy, self.value, self.norm = make_models(dims, self.n_act, Bounded(-1.0, 1.0, (self.n_act,)),
+                                                         cfg["model"])
         self.policy.to(self.device)
         self.value.to(self.device)
         lc = cfg["loss"]
@@ -149,12 +175,13 @@ class PPOTrainer:
         self.dims = dims
         if self.ckpt is not None:
             self._load_state(self.ckpt)
-        self.batch_envs = int(np.prod(self.env.batch_size)) if len(self.env.batch_size) else 1
-        self.frames_per_batch = self.batch_envs * self.horizon
+        self.collector.set_actor(self.policy.module[0].module)  # after loading: the workers share these weights
+        self.batch_envs = num_envs
+        self.frames_per_batch = self.collector.frames_per_batch
         self.minibatch = min(cfg["optim"]["minibatch_size"], self.frames_per_batch)
         self.rb = TensorDictReplayBuffer(storage=LazyTensorStorage(self.frames_per_batch, device=self.device),
                                          sampler=SamplerWithoutReplacement(), batch_size=self.minibatch)
-        self._ep_return = torch.zeros(self.env.batch_size + (1,), device=self.device)
+        self._ep_return = torch.zeros(num_envs, 1, device=self.device)
 
     # ------------------------------------------------------------------ state
     def _seed_everything(self, seed: int):
@@ -337,13 +364,12 @@ class PPOTrainer:
             self._log_eval(summary["start"])
         if remaining == 0:
             return summary
-        collector = Collector(self.env, self.policy, frames_per_batch=self.frames_per_batch, total_frames=remaining,
-                              device=self.device, auto_register_policy_transforms=False)
         bar = tqdm(total=total, initial=self.frames, unit="frame", desc=f"ppo {self.skill}", disable=not self.progress)
         t_last = time.perf_counter()
         done_iters = 0
         try:
-            for data in collector:
+            while self.frames < total:
+                data = self.collector.collect()
                 t_collect = time.perf_counter() - t_last
                 self.iteration += 1
                 self.frames += data.numel()
@@ -353,7 +379,6 @@ class PPOTrainer:
                 t0 = time.perf_counter()
                 up = self._update(data)
                 t_update = time.perf_counter() - t0
-                collector.update_policy_weights_()
                 terms = {k: float(data["next", "info", k].mean()) for k in data["next", "info"].keys()
                          if k.startswith("reward_")}
                 row = dict(iteration=self.iteration, frames=self.frames, wall_s=self._wall(), fps=data.numel() / max(t_collect + t_update, 1e-9),
@@ -373,7 +398,6 @@ class PPOTrainer:
         finally:
             self.save()
             bar.close()
-            collector.shutdown(close_env=False)
         if evaluating and self.frames >= total:
             summary["end"] = self.evaluate()
             self._log_eval(summary["end"])
@@ -453,6 +477,6 @@ class PPOTrainer:
 
     def close(self):
         try:
-            self.env.close()
+            self.collector.close()
         except Exception:
             pass

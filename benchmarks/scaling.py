@@ -1,0 +1,108 @@
+"""Training frames/s vs CPU env workers, against the rate of one env alone, in one run.
+
+single env:  ``task.step`` of one in-process grasp env with small random actions (resets and scene
+             rebuilds included, as in training), no policy: the physics + task rate of one core;
+training W:  ``unicross train``'s loop (lean collector with W worker processes, the actor inside
+             each, GAE and the real PPO update at the default batch of 1024 frames), frames/s over
+             ``--iterations`` iterations after one warm-up iteration;
+efficiency:  training W / (W x single env)  (target: >= 0.8 at 2 workers, issue "Training at the
+             speed of physics").
+
+Writes JSON (``--json``) and a PNG curve (``--png``).
+
+    python benchmarks/scaling.py [--workers 1 2] [--iterations 4] [--json docs/scaling.json] [--png docs/scaling.png]
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+import tempfile
+import time
+
+import torch
+
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+import gymnasium as gym  # noqa: E402
+
+import unicross  # noqa: E402,F401
+from unicross.rl.ppo import PPOTrainer  # noqa: E402
+
+
+def single_env_rate(steps: int, seed: int = 0) -> float:
+    env = gym.make("UniCross-Grasp-v1", obs_mode="state_dict", render_backend="none", sim_backend="physx_cpu",
+                   reconfiguration_freq=4)
+    u = env.unwrapped
+    g = torch.Generator().manual_seed(seed)
+    u.reset(seed=seed)
+    n = 0
+    t0 = time.perf_counter()
+    while n < steps:
+        a = (torch.rand(1, u.hand_spec.dof, generator=g) * 2 - 1) * 0.2
+        _, _, term, trunc, _ = u.step(a)
+        n += 1
+        if bool((term | trunc).any()):
+            u.reset()
+    rate = n / (time.perf_counter() - t0)
+    env.close()
+    return rate
+
+
+def training_rate(workers: int, iterations: int) -> dict:
+    run = os.path.join(tempfile.mkdtemp(), "r")
+    t = PPOTrainer(run, "grasp", progress=False,
+                   overrides=dict(env=dict(num_envs=workers), collector=dict(total_frames=10 ** 9),
+                                  logging=dict(eval_trials=0, final_eval_trials=0, checkpoint_every=10 ** 6)))
+    try:
+        t.train(max_iterations=1, eval_at_ends=False)  # warm up (first batch fits the statistics)
+        f0, t0 = t.frames, time.perf_counter()
+        t.train(max_iterations=iterations, eval_at_ends=False)
+        fps = (t.frames - f0) / (time.perf_counter() - t0)
+        rows = [json.loads(line) for line in open(os.path.join(run, "metrics.jsonl"))][-iterations:]
+        coll = sum(r["collect_s"] for r in rows)
+        upd = sum(r["update_s"] for r in rows)
+    finally:
+        t.close()
+    return dict(workers=workers, frames_per_iteration=t.frames_per_batch, training_fps=round(fps, 1),
+                collect_share=round(coll / (coll + upd), 3), update_share=round(upd / (coll + upd), 3))
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--workers", type=int, nargs="+", default=[1, 2])
+    p.add_argument("--iterations", type=int, default=4)
+    p.add_argument("--env-steps", type=int, default=1500)
+    p.add_argument("--json", default=None)
+    p.add_argument("--png", default=None)
+    args = p.parse_args()
+    single = single_env_rate(args.env_steps)
+    rows = []
+    for w in args.workers:
+        r = training_rate(w, args.iterations)
+        r["efficiency"] = round(r["training_fps"] / (w * single), 3)
+        rows.append(r)
+        print(json.dumps(r), flush=True)
+    out = dict(single_env_steps_per_s=round(single, 1), cores=os.cpu_count(), rows=rows)
+    print(json.dumps(out, indent=1))
+    if args.json:
+        with open(args.json, "w") as f:
+            json.dump(out, f, indent=1)
+    if args.png:
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+        ws = [r["workers"] for r in rows]
+        fig, ax = plt.subplots(figsize=(5, 3.5))
+        ax.plot(ws, [r["training_fps"] for r in rows], "o-", label="training (PPO, lean collector)")
+        ax.plot(ws, [w * single for w in ws], "--", color="gray", label="workers x single env")
+        ax.set_xlabel("env worker processes")
+        ax.set_ylabel("frames/s")
+        ax.set_title(f"Allegro grasp, {os.cpu_count()} cores")
+        ax.legend()
+        fig.tight_layout()
+        fig.savefig(args.png, dpi=120)
+
+
+if __name__ == "__main__":
+    main()

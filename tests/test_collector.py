@@ -1,0 +1,62 @@
+"""The lean collector: worker processes act with the main process's current weights, store the
+log-probabilities the PPO loss recomputes, and keep episode boundaries as TorchRL's GAE reads them."""
+import pytest
+import torch
+from torchrl.data import Bounded
+
+from unicross.rl.collector import LeanCollector
+from unicross.rl.models import make_models
+
+KW = dict(object_limit=1, reconfiguration_freq=1, config={"terminate_on_drop": False})  # episodes end at 64 steps
+
+
+def _models(c):
+    policy, _, norm = make_models(c.dims, c.n_act, Bounded(-1.0, 1.0, (c.n_act,)),
+                                  dict(action_init_scale=0.01, init_log_std=-1.5))
+    return policy, norm
+
+
+def _check_batch(policy, data):
+    """Stored loc/scale/log-prob are what the main process's policy gives now."""
+    with torch.no_grad():
+        obs = data.select("hand", "object", "goal")
+        loc, scale = policy.module[0].module(obs["hand"], obs["object"], obs["goal"])
+        logp = policy.get_dist(obs).log_prob(data["action"])
+    torch.testing.assert_close(data["loc"], loc, atol=1e-5, rtol=1e-5)
+    torch.testing.assert_close(data["scale"], scale)
+    torch.testing.assert_close(data["action_log_prob"], logp, atol=1e-4, rtol=1e-5)
+
+
+@pytest.mark.parametrize("num_envs", [1, 2])
+def test_workers_act_with_current_weights(num_envs):
+    c = LeanCollector("UniCross-Grasp-v1", KW, num_envs=num_envs, horizon=70, seed=3)
+    try:
+        policy, norm = _models(c)
+        c.set_actor(policy.module[0].module)
+        data = c.collect()
+        assert data.shape == (num_envs, 70)
+        _check_batch(policy, data)
+        # an in-place change in the main process (as the optimiser and the statistics make) is
+        # what the workers act with in the next batch
+        with torch.no_grad():
+            policy.module[0].module.net.main[-1].bias.add_(0.3)
+            norm.update({k: data[k] for k in ("hand", "object", "goal")})
+        data2 = c.collect()
+        _check_batch(policy, data2)
+        assert (data2["loc"] - data["loc"]).abs().mean() > 0.1
+        # grasp episodes are 64 steps: step 63 ends each env's first episode (truncated), the next
+        # step starts a fresh one whose observation differs from the stored terminal one
+        done = data["next", "done"][..., 0]
+        assert done[:, 63].all() and not done[:, :63].any()
+        assert data["next", "truncated"][:, 63].all()
+        assert not torch.equal(data["hand"][:, 64], data["next", "hand"][:, 63])
+        assert torch.equal(data["hand"][:, 1:63], data["next", "hand"][:, :62])
+        if num_envs == 2:  # envs are seeded differently
+            assert not torch.equal(data["hand"][0, 0], data["hand"][1, 0])
+    finally:
+        c.close()
+
+
+def test_worker_errors_are_raised_in_the_main_process():
+    with pytest.raises(RuntimeError, match="env worker 0"):
+        LeanCollector("UniCross-Grasp-v1", dict(KW, objects="no-such-set"), num_envs=2, horizon=4)

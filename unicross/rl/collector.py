@@ -1,0 +1,241 @@
+"""A lean rollout collector: the policy runs next to the physics, rollouts land in shared memory.
+
+On the CPU, SAPIEN simulates one env per process. Each worker process holds one env and the
+actor (weights and observation statistics in shared memory, so every optimiser step is seen by
+the workers without copying) and writes its rollout straight into its row of a preallocated
+shared ``[num_envs, T]`` TensorDict; the main process only computes GAE and the update. This
+replaces TorchRL's ``ParallelEnv`` + ``Collector`` on the CPU, which measured slower with two
+workers than one in-process env (the parallel env's main process busy-waits on its workers, and
+the TensorDict policy and env-wrapper calls cost ~2 ms per frame; see ``benchmarks/``).
+
+With ``num_envs == 1`` on the CPU, or on the GPU (one ``physx_cuda`` env of ``num_envs``
+sub-scenes), the same rollout loop runs in the main process.
+
+Batch layout (what TorchRL's GAE and ``ClipPPOLoss`` read), ``[num_envs, T]``: ``hand``,
+``object``, ``goal`` (observation), ``action`` (the sampled, unclipped action; the task clips),
+``action_log_prob``, ``loc``, ``scale``, and under ``next``: the observation after the step (the
+last one of an episode, before the reset), ``reward``, ``done``, ``terminated`` (object dropped),
+``truncated`` (episode length), and ``info`` (the task's per-term rewards and flags,
+:data:`unicross.rl.env.INFO_FLOAT` / ``INFO_BOOL``).
+"""
+from __future__ import annotations
+
+import math
+import traceback
+from typing import Optional
+
+import torch
+import torch.multiprocessing as mp
+from tensordict import TensorDict
+
+from unicross.rl.env import INFO_BOOL, INFO_FLOAT
+
+OBS_KEYS = ("hand", "object", "goal")
+
+
+def split_obs(obs: dict) -> tuple:
+    """(hand, object, goal) tensors [N, d] of a UniCross ``state_dict`` observation."""
+    o = obs["extra"]
+    obj = torch.cat([o["object"]["contact"], o["object"]["force"], o["object"]["distance"]], dim=-1)
+    return o["hand"], obj, o["goal"]
+
+
+def make_buffer(n: int, horizon: int, dims: dict, n_act: int, device="cpu") -> TensorDict:
+    """Zeroed rollout storage ``[n, horizon]`` with the keys of the module docstring."""
+    b = (n, horizon)
+    z = lambda *s, dtype=torch.float32: torch.zeros(b + s, dtype=dtype, device=device)  # noqa: E731
+    obs = {k: z(dims[k]) for k in OBS_KEYS}
+    info = {k: z(1) for k in INFO_FLOAT} | {k: z(1, dtype=torch.bool) for k in INFO_BOOL}
+    nxt = {k: z(dims[k]) for k in OBS_KEYS} | dict(
+        reward=z(1), done=z(1, dtype=torch.bool), terminated=z(1, dtype=torch.bool),
+        truncated=z(1, dtype=torch.bool), info=TensorDict(info, batch_size=b, device=device))
+    return TensorDict({**obs, "action": z(n_act), "action_log_prob": z(), "loc": z(n_act), "scale": z(n_act),
+                       "next": TensorDict(nxt, batch_size=b, device=device)}, batch_size=b, device=device)
+
+
+class Rollout:
+    """One (batched) UniCross task stepped by an actor (a module ``(hand, object, goal) -> (loc,
+    scale)`` of a diagonal Gaussian, set with :meth:`set_actor`). Episodes run on across
+    :meth:`collect` calls; finished envs are reset (unseeded: each reset continues the task's
+    generator) right after their last step."""
+
+    def __init__(self, env_id: str, env_kwargs: dict, seed: int):
+        import gymnasium as gym
+        import unicross  # noqa: F401  (registers the tasks)
+        kw = dict(render_backend="none", **env_kwargs)
+        kw["obs_mode"] = "state_dict"
+        self._gym = gym.make(env_id, **kw)
+        self.task = self._gym.unwrapped
+        self.actor: Optional[torch.nn.Module] = None
+        self.device = self.task.device
+        self.gen = torch.Generator(device=self.device)
+        self.gen.manual_seed(seed)
+        obs, _ = self.task.reset(seed=seed)
+        self.obs = split_obs(obs)
+        self.dims = {k: x.shape[-1] for k, x in zip(OBS_KEYS, self.obs)}
+        self.n_act = int(self.task.single_action_space.shape[0])
+
+    def set_actor(self, actor: torch.nn.Module) -> None:
+        self.actor = actor
+
+    @torch.no_grad()
+    def collect(self, buf: TensorDict) -> None:
+        """Fills ``buf`` [num_envs, T] (plain tensor writes, no TensorDict work per step)."""
+        leaves = {k: buf.get(k) for k in buf.keys(include_nested=True, leaves_only=True)}
+        nxt_obs = [leaves[("next", k)] for k in OBS_KEYS]
+        obs_buf = [leaves[k] for k in OBS_KEYS]
+        info_keys = [(k, leaves[("next", "info", k)]) for k in INFO_FLOAT + INFO_BOOL]
+        act, logp, loc_b, scale_b = leaves["action"], leaves["action_log_prob"], leaves["loc"], leaves["scale"]
+        rew, done_b = leaves[("next", "reward")], leaves[("next", "done")]
+        term_b, trunc_b = leaves[("next", "terminated")], leaves[("next", "truncated")]
+        half_log_2pi = 0.5 * math.log(2 * math.pi)
+        for t in range(buf.shape[1]):
+            for dst, x in zip(obs_buf, self.obs):
+                dst[:, t] = x
+            loc, scale = self.actor(*self.obs)
+            noise = torch.randn(loc.shape, generator=self.gen, device=loc.device)
+            a = loc + scale * noise
+            act[:, t], loc_b[:, t], scale_b[:, t] = a, loc, scale
+            logp[:, t] = (-0.5 * noise ** 2 - scale.log() - half_log_2pi).sum(-1)
+            obs, reward, terminated, truncated, info = self.task.step(a)
+            nxt = split_obs(obs)
+            for dst, x in zip(nxt_obs, nxt):
+                dst[:, t] = x
+            rew[:, t, 0] = reward
+            term_b[:, t, 0], trunc_b[:, t, 0] = terminated, truncated
+            done = terminated | truncated
+            done_b[:, t, 0] = done
+            for k, dst in info_keys:
+                dst[:, t, 0] = info[k]
+            if bool(done.any()):
+                options = {} if self.task.num_envs == 1 else {"env_idx": torch.nonzero(done).flatten()}
+                obs, _ = self.task.reset(options=options)
+                fresh = split_obs(obs)
+                nxt = fresh if self.task.num_envs == 1 else \
+                    tuple(torch.where(done[:, None], f, x) for f, x in zip(fresh, nxt))
+            self.obs = nxt
+
+    def close(self):
+        self._gym.close()
+
+
+def _worker(rank: int, env_id: str, env_kwargs: dict, seed: int, conn) -> None:
+    """Worker process: one env. Reports its sizes, receives the shared actor and buffer, then
+    fills row ``rank`` of the buffer on every "collect"."""
+    torch.set_num_threads(1)
+    try:
+        rollout = Rollout(env_id, env_kwargs, seed)
+        conn.send(("ready", (rollout.dims, rollout.n_act)))
+        msg, (actor, buf) = conn.recv()
+        rollout.set_actor(actor)
+        row = buf[rank:rank + 1]
+        conn.send(("ready", None))
+    except Exception:  # reported to the main process, which raises it
+        conn.send(("error", traceback.format_exc()))
+        return
+    while True:
+        cmd = conn.recv()
+        if cmd == "close":
+            break
+        try:
+            rollout.collect(row)
+            conn.send(("done", None))
+        except Exception:
+            conn.send(("error", traceback.format_exc()))
+    rollout.close()
+
+
+class LeanCollector:
+    """Rollouts in ``num_envs`` envs of ``env_id``, ``horizon`` steps per env per batch.
+
+    CPU with ``num_envs > 1``: one worker process per env (spawned). CPU with one env, or the GPU
+    backend: in the main process. Env ``i`` starts from a reset seeded with ``seed + i`` and draws
+    its action noise from a generator seeded likewise. The envs are built first (``dims``,
+    ``n_act`` come from them); :meth:`set_actor` then hands them the actor, whose tensors are moved
+    to shared memory, so the optimiser's in-place steps and the statistics updates reach the workers.
+    """
+
+    def __init__(self, env_id: str, env_kwargs: dict, num_envs: int, horizon: int, seed: int = 0,
+                 backend: str = "physx_cpu"):
+        self.horizon, self.num_envs = horizon, num_envs
+        kw = dict(env_kwargs)
+        self._procs, self._conns, self._local, self.buf = [], [], None, None
+        if backend == "physx_cuda":
+            kw.update(sim_backend="physx_cuda", num_envs=num_envs)
+        else:
+            kw.update(sim_backend="physx_cpu", num_envs=1)
+        if backend == "physx_cuda" or num_envs == 1:
+            self._local = Rollout(env_id, kw, seed)
+            self.dims, self.n_act, self.device = self._local.dims, self._local.n_act, self._local.device
+            return
+        ctx = mp.get_context("spawn")
+        for rank in range(num_envs):
+            parent, child = ctx.Pipe()
+            p = ctx.Process(target=_worker, args=(rank, env_id, kw, seed + rank, child), daemon=True,
+                            name=f"unicross-env-{rank}")
+            p.start()
+            self._procs.append(p)
+            self._conns.append(parent)
+        self.dims, self.n_act = self._wait("ready")[0]
+        self.device = torch.device("cpu")
+
+    @property
+    def frames_per_batch(self) -> int:
+        return self.num_envs * self.horizon
+
+    def set_actor(self, actor: torch.nn.Module) -> None:
+        """The module ``(hand, object, goal) -> (loc, scale)`` the envs act with."""
+        if self._local is not None:
+            self._local.set_actor(actor)
+            self.buf = make_buffer(self.num_envs, self.horizon, self.dims, self.n_act, self.device)
+            return
+        actor.share_memory()
+        self.buf = make_buffer(self.num_envs, self.horizon, self.dims, self.n_act).share_memory_()
+        for conn in self._conns:
+            conn.send(("setup", (actor, self.buf)))
+        self._wait("ready")
+
+    def _wait(self, expected: str) -> list:
+        errors, payloads = [], []
+        for rank, conn in enumerate(self._conns):
+            try:
+                msg, payload = conn.recv()
+            except EOFError:
+                msg, payload = "error", f"worker {rank} exited (exit code {self._procs[rank].exitcode})"
+            if msg == "error":
+                errors.append(f"env worker {rank}:\n{payload}")
+            elif msg != expected:
+                errors.append(f"env worker {rank}: unexpected message {msg!r}")
+            payloads.append(payload)
+        if errors:
+            self.close()
+            raise RuntimeError("\n".join(errors))
+        return payloads
+
+    def collect(self) -> TensorDict:
+        """One batch ``[num_envs, horizon]`` (a copy: the caller may add keys and rescale)."""
+        if self.buf is None:
+            raise RuntimeError("set_actor() first")
+        if self._local is not None:
+            self._local.collect(self.buf)
+        else:
+            for conn in self._conns:
+                conn.send("collect")
+            self._wait("done")
+        return self.buf.clone()
+
+    def close(self) -> None:
+        if self._local is not None:
+            self._local.close()
+            self._local = None
+        for conn, p in zip(self._conns, self._procs):
+            try:
+                if p.is_alive():
+                    conn.send("close")
+            except (BrokenPipeError, OSError):
+                pass
+        for p in self._procs:
+            p.join(timeout=10)
+            if p.is_alive():
+                p.terminate()
+        self._procs, self._conns = [], []
