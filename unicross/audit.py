@@ -15,8 +15,9 @@ Grasp behaviours (scripted on the task's own state, through the normal action in
   zero           no action
   random         uniform random actions
 
-Relocate: ``follow`` (zero residual action: the wrist follows the task's interpolated target
-with the object held: the successful reference), ``naive`` (the paper's naive baseline: wrist
+Relocate: ``follow`` (the successful reference: zero wrist residual, so the wrist follows the
+task's interpolated target, with the grasp's fingers tightened by 0.1 rad to hold the object),
+``follow_loose`` (the same with zero finger action), ``naive`` (the paper's naive baseline: wrist
 driven straight to the goal, fingers tightened), ``stay`` (the wrist holds its start pose) and
 ``random``.
 
@@ -82,6 +83,13 @@ def _stay(u):
     return act
 
 
+def _follow_relocate(u):
+    """The relocate reference: the wrist follows its Tracked reference (zero residual) while the
+    fingers hold the grasp slightly tightened (as the paper's naive baseline does)."""
+    from unicross.evaluation import tightened_fingers_action
+    return lambda: tightened_fingers_action(u)
+
+
 def _naive_relocate(u):
     from unicross.evaluation import scripted_relocate_policy
     return lambda: scripted_relocate_policy(None, u)
@@ -125,7 +133,8 @@ def behaviours(skill: str, seed: int = 0) -> Dict[str, Callable]:
                     hover=_grasp_script(lift=False, close=False, descend=True),
                     close_only=_grasp_script(lift=False, close=True, descend=False), **common)
     if skill == "relocate":
-        return dict(follow=_zero, naive=_naive_relocate, stay=_stay, random=common["random"])
+        return dict(follow=_follow_relocate, follow_loose=_zero, naive=_naive_relocate, stay=_stay,
+                    random=common["random"])
     if skill in ("rotate", "translate"):
         return dict(oracle=_oracle, **common)
     raise ValueError(f"unknown skill {skill!r}; valid: grasp, relocate, rotate, translate")

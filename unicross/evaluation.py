@@ -60,17 +60,24 @@ def make_random_policy(seed: int) -> PolicyFn:
     return policy
 
 
+def tightened_fingers_action(u, tighten: float = 0.1) -> torch.Tensor:
+    """Action [N, dof] that drives the fingers to their grasp pose closed by at most ``tighten``
+    rad along the hand's closing direction (wrist residual zero: the wrist follows its reference)."""
+    from unicross.scripted_grasp import closing_delta
+    a = torch.zeros(u.num_envs, u.hand_spec.dof, device=u.device)
+    delta = closing_delta(u.hand_spec).to(u.device)
+    delta = delta / delta.abs().max().clamp(min=1e-6) * tighten  # closing direction, at most `tighten` rad
+    q_des = torch.clamp(u.finger_q0 + delta, u.q_lower[6:], u.q_upper[6:])
+    a[:, 6:] = (q_des - u.command[:, 6:]) / u.action_scale[6:]
+    return a.clamp(-1.0, 1.0)
+
+
 def scripted_relocate_policy(obs, u, tighten: float = 0.1) -> torch.Tensor:
     """The paper's naive relocation baseline: tighten the fingers of the grasp slightly and drive
     the wrist (PD, through the action interface) to the pose that realises the final object pose
     with the object-in-hand pose fixed at its start value."""
-    a = torch.zeros(u.num_envs, u.hand_spec.dof, device=u.device)
+    a = tightened_fingers_action(u, tighten)
     scale = u.action_scale
-    from unicross.scripted_grasp import closing_delta
-    delta = closing_delta(u.hand_spec).to(u.device)
-    delta = delta / delta.abs().max().clamp(min=1e-6) * tighten  # closing direction, at most `tighten` rad
-    q_des = torch.clamp(u.finger_q0 + delta, u.q_lower[6:], u.q_upper[6:])
-    a[:, 6:] = (q_des - u.command[:, 6:]) / scale[6:]
     init = u.init_rel
     ip, iq = pose_inv(init.x_oh, init.q_oh)
     hx, hq = pose_mul(u.final_x_or, u.final_q_or, ip, iq)
