@@ -203,9 +203,10 @@ class UniCrossEnv(BaseEnv):
             b.initial_pose = sapien.Pose(p=[0, 0, -0.025])
             self.table = b.build_static(name="table")
         rng = self._batched_episode_rng[0]
-        # envs take consecutive pairs from a cursor that starts at a seeded random place and moves
-        # on at every rebuild, so parallel envs and reconfigurations cover the pairs uniformly
-        if not hasattr(self, "_pair_cursor"):
+        # envs take consecutive pairs from a cursor that starts at a seeded random place (again at
+        # every seeded reset) and moves on at every rebuild, so parallel envs and reconfigurations
+        # cover the pairs uniformly
+        if not hasattr(self, "_pair_cursor") or getattr(self, "_seeded_reset", False):
             self._pair_cursor = int(rng.randint(len(self._pairs)))
         pairs = [self._pairs[(self._pair_cursor + i) % len(self._pairs)] for i in range(self.num_envs)]
         self._pair_cursor += self.num_envs
@@ -449,6 +450,11 @@ class UniCrossEnv(BaseEnv):
 
     def reset(self, seed=None, options=None):
         self._seeded_reset = seed is not None
+        if seed is not None and self.reconfiguration_freq and len(self._pairs) > self.num_envs:
+            # a seeded reset replays its episode: the object (and its mass and friction) must come
+            # from the seed too, not from wherever the rebuild cursor stands
+            options = dict(options or {})
+            options.setdefault("reconfigure", True)
         obs, info = super().reset(seed=seed, options=options)
         # finger drive targets of a restored grasp (the controller reset set them to qpos)
         self._apply_command()

@@ -89,19 +89,29 @@ def test_unseeded_resets_differ_and_seeded_resets_repeat_the_start(env_id, kw):
     env.close()
 
 
-def test_seeded_grasp_episode_replays_exactly_with_randomisation():
-    env = gym.make("UniCross-Grasp-v1", randomize=True, **ENV)
+@pytest.mark.parametrize("env_id,kw", [("UniCross-Grasp-v1", {}), ("UniCross-Relocate-v1", {}),
+                                       ("UniCross-Rotate-v1", dict(axis="x-")),
+                                       ("UniCross-Translate-v1", dict(direction="z+"))])
+def test_seeded_episode_replays_exactly_with_randomisation_and_rebuilds(env_id, kw):
+    """A seeded reset replays its whole episode (object, mass, friction, start, noise and
+    perturbations, physics) whatever ran before it, on the full object set with scene rebuilds."""
+    env = gym.make(env_id, randomize=True, reconfiguration_freq=4, obs_mode="state_dict", sim_backend="physx_cpu",
+                   render_backend="none", **kw)
     u = env.unwrapped
 
-    def episode():
-        u.reset(seed=5)
-        g = torch.Generator().manual_seed(1)
+    def episode(seed=5, action_seed=1, steps=60):
+        u.reset(seed=seed)
+        g = torch.Generator().manual_seed(action_seed)
         out = []
-        for _ in range(20):
-            obs, r, *_ = u.step(torch.rand(1, u.hand_spec.dof, generator=g) * 2 - 1)
-            out.append(torch.cat([obs["extra"]["hand"], r[:, None]], -1))
+        for _ in range(steps):
+            obs, r, *_ = u.step((torch.rand(1, u.hand_spec.dof, generator=g) * 2 - 1) * 0.3)
+            out.append(torch.cat([obs["extra"]["hand"], obs["extra"]["goal"], r[:, None]], -1))
         return torch.cat(out)
     first = episode()
+    episode(seed=9, action_seed=3, steps=30)  # something else in between: another seeded episode ...
+    for _ in range(3):  # ... and unseeded ones that move the rebuild cursor
+        u.reset()
+        u.step(torch.zeros(1, u.hand_spec.dof))
     assert torch.equal(episode(), first)
     env.close()
 
