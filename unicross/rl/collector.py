@@ -28,16 +28,9 @@ import torch
 import torch.multiprocessing as mp
 from tensordict import TensorDict
 
-from unicross.rl.env import INFO_BOOL, INFO_FLOAT
+from unicross.rl.env import INFO_BOOL, INFO_FLOAT, split_obs
 
 OBS_KEYS = ("hand", "object", "goal")
-
-
-def split_obs(obs: dict) -> tuple:
-    """(hand, object, goal) tensors [N, d] of a UniCross ``state_dict`` observation."""
-    o = obs["extra"]
-    obj = torch.cat([o["object"]["contact"], o["object"]["force"], o["object"]["distance"]], dim=-1)
-    return o["hand"], obj, o["goal"]
 
 
 def make_buffer(n: int, horizon: int, dims: dict, n_act: int, device="cpu") -> TensorDict:
@@ -59,7 +52,7 @@ class Rollout:
     :meth:`collect` calls; finished envs are reset (unseeded: each reset continues the task's
     generator) right after their last step."""
 
-    def __init__(self, env_id: str, env_kwargs: dict, seed: int):
+    def __init__(self, env_id: str, env_kwargs: dict, seed: int, deterministic: bool = False):
         import gymnasium as gym
         import unicross  # noqa: F401  (registers the tasks)
         kw = dict(render_backend="none", **env_kwargs)
@@ -67,6 +60,7 @@ class Rollout:
         self._gym = gym.make(env_id, **kw)
         self.task = self._gym.unwrapped
         self.actor: Optional[torch.nn.Module] = None
+        self.deterministic = deterministic
         self.device = self.task.device
         self.gen = torch.Generator(device=self.device)
         self.gen.manual_seed(seed)
@@ -93,7 +87,8 @@ class Rollout:
             for dst, x in zip(obs_buf, self.obs):
                 dst[:, t] = x
             loc, scale = self.actor(*self.obs)
-            noise = torch.randn(loc.shape, generator=self.gen, device=loc.device)
+            noise = torch.zeros_like(loc) if self.deterministic else \
+                torch.randn(loc.shape, generator=self.gen, device=loc.device)
             a = loc + scale * noise
             act[:, t], loc_b[:, t], scale_b[:, t] = a, loc, scale
             logp[:, t] = (-0.5 * noise ** 2 - scale.log() - half_log_2pi).sum(-1)
@@ -119,12 +114,12 @@ class Rollout:
         self._gym.close()
 
 
-def _worker(rank: int, env_id: str, env_kwargs: dict, seed: int, conn) -> None:
+def _worker(rank: int, env_id: str, env_kwargs: dict, seed: int, deterministic: bool, conn) -> None:
     """Worker process: one env. Reports its sizes, receives the shared actor and buffer, then
     fills row ``rank`` of the buffer on every "collect"."""
     torch.set_num_threads(1)
     try:
-        rollout = Rollout(env_id, env_kwargs, seed)
+        rollout = Rollout(env_id, env_kwargs, seed, deterministic)
         conn.send(("ready", (rollout.dims, rollout.n_act)))
         msg, (actor, buf) = conn.recv()
         rollout.set_actor(actor)
@@ -150,13 +145,14 @@ class LeanCollector:
 
     CPU with ``num_envs > 1``: one worker process per env (spawned). CPU with one env, or the GPU
     backend: in the main process. Env ``i`` starts from a reset seeded with ``seed + i`` and draws
-    its action noise from a generator seeded likewise. The envs are built first (``dims``,
+    its action noise from a generator seeded likewise (``deterministic``: the mean action, as
+    DAgger's student acts; the stored log-probability is then that of the mean). The envs are built first (``dims``,
     ``n_act`` come from them); :meth:`set_actor` then hands them the actor, whose tensors are moved
     to shared memory, so the optimiser's in-place steps and the statistics updates reach the workers.
     """
 
     def __init__(self, env_id: str, env_kwargs: dict, num_envs: int, horizon: int, seed: int = 0,
-                 backend: str = "physx_cpu"):
+                 backend: str = "physx_cpu", deterministic: bool = False):
         self.horizon, self.num_envs = horizon, num_envs
         kw = dict(env_kwargs)
         self._procs, self._conns, self._local, self.buf = [], [], None, None
@@ -165,13 +161,13 @@ class LeanCollector:
         else:
             kw.update(sim_backend="physx_cpu", num_envs=1)
         if backend == "physx_cuda" or num_envs == 1:
-            self._local = Rollout(env_id, kw, seed)
+            self._local = Rollout(env_id, kw, seed, deterministic)
             self.dims, self.n_act, self.device = self._local.dims, self._local.n_act, self._local.device
             return
         ctx = mp.get_context("spawn")
         for rank in range(num_envs):
             parent, child = ctx.Pipe()
-            p = ctx.Process(target=_worker, args=(rank, env_id, kw, seed + rank, child), daemon=True,
+            p = ctx.Process(target=_worker, args=(rank, env_id, kw, seed + rank, deterministic, child), daemon=True,
                             name=f"unicross-env-{rank}")
             p.start()
             self._procs.append(p)

@@ -1,6 +1,7 @@
 """DAgger distillation of the ten per-mode experts into one student (paper §3.3).
 
-Each epoch the student acts in ``UniCross-MultiSkill-v1`` (environments spread over valid
+Each epoch the student acts (its mean action; CPU: one env per worker process, the lean collector
+of :mod:`unicross.rl.collector`) in ``UniCross-MultiSkill-v1`` (environments spread over valid
 (object, mode) pairs) for ``rollout_steps``; every visited state is labelled by the frozen expert
 of its mode (query rate 100%); the (observation, expert action) pairs go to a TensorDict replay
 buffer (``LazyTensorStorage``, capacity 1e6 by default); the student then takes
@@ -22,14 +23,13 @@ from typing import Dict, Optional
 import numpy as np
 import torch
 from tensordict import TensorDict
-from torchrl.collectors import Collector
-from torchrl.data import LazyTensorStorage, TensorDictReplayBuffer
+from torchrl.data import Bounded, LazyTensorStorage, TensorDictReplayBuffer
 from torchrl.envs.utils import ExplorationType, set_exploration_type
 from tqdm import tqdm
 
 from unicross import formulation as F
-from unicross.rl.env import make_env
-from unicross.rl.models import OBS_KEYS, make_models, obs_dims_from_spec
+from unicross.rl.collector import LeanCollector
+from unicross.rl.models import OBS_KEYS, make_models
 from unicross.rl.policy_io import load_policy
 from unicross.rl.ppo import atomic_save, git_commit, open_run
 
@@ -103,11 +103,15 @@ class DAggerTrainer:
         self.teachers = Teachers(paths, self.device)
         kw["hand"] = self.teachers.hand
         self.env_kwargs = kw
-        self.env = make_env("UniCross-MultiSkill-v1", kw, ec["num_envs"], ec["backend"])
-        self.env.set_seed(cfg["seed"])
-        self.dims = obs_dims_from_spec(self.env.observation_spec)
-        self.n_act = self.env.action_spec.shape[-1]
-        self.student, _, self.norm = make_models(self.dims, self.n_act, self.env.action_spec, cfg["model"])
+        from unicross.rl.ppo import resolve_num_envs
+        # the student acts (its mean action) in worker processes with shared weights (lean collector)
+        self.collector = LeanCollector("UniCross-MultiSkill-v1", kw, resolve_num_envs(ec["num_envs"], ec["backend"]),
+                                       cfg["collector"]["rollout_steps"], seed=cfg["seed"] + 1000 * int(
+                                           (self.ckpt or {}).get("epoch", 0)),
+                                       backend=ec["backend"], deterministic=True)
+        self.dims, self.n_act = self.collector.dims, self.collector.n_act
+        self.student, _, self.norm = make_models(self.dims, self.n_act, Bounded(-1.0, 1.0, (self.n_act,)),
+                                                 cfg["model"])
         self.student.to(self.device)
         self.actor = self.student.module[0]  # hand/object/goal -> loc, scale
         self.optim = torch.optim.Adam(self.actor.parameters(), lr=cfg["optim"]["lr"])
@@ -116,11 +120,7 @@ class DAggerTrainer:
         self.epoch, self.frames = 0, 0
         if self.ckpt is not None:
             self._load(self.ckpt)
-        n_envs = int(np.prod(self.env.batch_size)) if len(self.env.batch_size) else 1
-        self.collector = Collector(self.env, self.student, frames_per_batch=n_envs * cfg["collector"]["rollout_steps"],
-                                   total_frames=-1, device=self.device, exploration_type=ExplorationType.DETERMINISTIC,
-                                   auto_register_policy_transforms=False)
-        self._batches = iter(self.collector)
+        self.collector.set_actor(self.actor.module)  # after loading: the workers share these weights
 
     # ------------------------------------------------------------------ state
     def _seed(self, seed):
@@ -156,7 +156,7 @@ class DAggerTrainer:
     def collect(self) -> dict:
         """Roll the student out for ``rollout_steps`` (deterministic actions); label every visited
         state by its mode's expert; store (observation, expert action, mode)."""
-        flat = next(self._batches).reshape(-1)
+        flat = self.collector.collect().reshape(-1)
         labels = self.teachers(flat)
         item = flat.select(*OBS_KEYS).clone()
         item["expert_action"] = labels
@@ -229,11 +229,4 @@ class DAggerTrainer:
         return last
 
     def close(self):
-        try:
-            self.collector.shutdown()
-        except Exception:
-            pass
-        try:
-            self.env.close()
-        except Exception:
-            pass
+        self.collector.close()

@@ -5,9 +5,9 @@ keys (``hand``, ``object``, ``goal``), reports ``terminated`` (object dropped) a
 (episode length reached) separately, carries the task's per-term rewards and success flags under
 ``info``, and supports partial resets (``_reset`` masks) on the GPU backend.
 
-On the CPU, SAPIEN simulates one env per process: :func:`make_env` then builds a ``ParallelEnv``
-of single-env workers (batch ``[W]``). On the GPU it builds one env with many sub-scenes
-(``physx_cuda``, batch ``[N]``). Both give the same keys and shapes per env.
+For TorchRL users (its collectors, transforms, ``rollout``). Training here does not go through it:
+on the CPU, :mod:`unicross.rl.collector` runs the policy inside one-env worker processes, which
+measured several times faster than a ``ParallelEnv`` of these envs with TorchRL's collector.
 """
 from __future__ import annotations
 
@@ -25,12 +25,17 @@ INFO_FLOAT = ("rotation", "translation", "relocate_pos_err", "relocate_rot_err")
 INFO_BOOL = ("success", "drop", "nonfinite")
 
 
-def obs_to_td(obs: dict, device=None) -> TensorDict:
-    """A UniCross ``state_dict`` observation -> TensorDict with keys hand, object, goal ([N, ...])."""
+def split_obs(obs: dict) -> tuple:
+    """(hand, object, goal) tensors [N, d] of a UniCross ``state_dict`` observation."""
     o = obs["extra"]
     obj = torch.cat([o["object"]["contact"], o["object"]["force"], o["object"]["distance"]], dim=-1)
-    return TensorDict({"hand": o["hand"], "object": obj, "goal": o["goal"]}, batch_size=[o["hand"].shape[0]],
-                      device=device)
+    return o["hand"], obj, o["goal"]
+
+
+def obs_to_td(obs: dict, device=None) -> TensorDict:
+    """A UniCross ``state_dict`` observation -> TensorDict with keys hand, object, goal ([N, ...])."""
+    hand, obj, goal = split_obs(obs)
+    return TensorDict({"hand": hand, "object": obj, "goal": goal}, batch_size=[hand.shape[0]], device=device)
 
 
 class ManiSkillEnv(EnvBase):
@@ -121,29 +126,3 @@ class ManiSkillEnv(EnvBase):
     def close(self, *, raise_if_closed: bool = True):
         self._gym.close()
         super().close(raise_if_closed=raise_if_closed)
-
-
-def make_env(env_id: str, env_kwargs: Optional[dict] = None, num_envs: int = 1, backend: str = "physx_cpu",
-             workers: Optional[int] = None):
-    """CPU: ``ParallelEnv`` of ``num_envs`` single-env worker processes (or one in-process env when
-    ``num_envs == 1``); GPU: one ``physx_cuda`` env with ``num_envs`` sub-scenes."""
-    from torchrl.envs import EnvCreator, ParallelEnv
-    kw = dict(env_kwargs or {})
-    if backend == "physx_cuda":
-        kw.update(sim_backend="physx_cuda", num_envs=num_envs)
-        return ManiSkillEnv(env_id, kw)
-    kw.update(sim_backend="physx_cpu", num_envs=1)
-    if num_envs == 1:
-        return ManiSkillEnv(env_id, kw)
-    return ParallelEnv(num_envs, EnvCreator(_Factory(env_id, kw)), mp_start_method="spawn")
-
-
-class _Factory:
-    """Picklable env factory for worker processes."""
-
-    def __init__(self, env_id, kw):
-        self.env_id, self.kw = env_id, kw
-
-    def __call__(self):
-        torch.set_num_threads(1)
-        return ManiSkillEnv(self.env_id, self.kw)

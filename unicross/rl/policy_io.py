@@ -5,7 +5,7 @@ from pathlib import Path
 
 import torch
 
-from unicross.rl.collector import split_obs
+from unicross.rl.env import split_obs
 from unicross.rl.models import make_models
 
 
