@@ -96,6 +96,7 @@ def main():
         fig, ax = plt.subplots(figsize=(5, 3.5))
         ax.plot(ws, [r["training_fps"] for r in rows], "o-", label="training (PPO, lean collector)")
         ax.plot(ws, [w * single for w in ws], "--", color="gray", label="workers x single env")
+        ax.set_xticks(ws)
         ax.set_xlabel("env worker processes")
         ax.set_ylabel("frames/s")
         ax.set_title(f"Allegro grasp, {os.cpu_count()} cores")

@@ -60,3 +60,20 @@ def test_workers_act_with_current_weights(num_envs):
 def test_worker_errors_are_raised_in_the_main_process():
     with pytest.raises(RuntimeError, match="env worker 0"):
         LeanCollector("UniCross-Grasp-v1", dict(KW, objects="no-such-set"), num_envs=2, horizon=4)
+
+
+def test_evaluation_in_the_workers_equals_one_process():
+    """The trainer's held-out evaluation runs split over the env workers; the trials are those of
+    one process running them all."""
+    from unicross.rl.ppo import evaluation_shard
+    c = LeanCollector("UniCross-Grasp-v1", KW, num_envs=2, horizon=4, seed=0)
+    try:
+        policy, _ = _models(c)
+        c.set_actor(policy.module[0].module)
+        kw = dict(skill="grasp", objects="test", limit=1, trials_per_object=1, seed=2, hand="allegro", axis=None,
+                  ablation=None)
+        split = [t for part in c.map_shards(evaluation_shard, **kw) for t in part]
+    finally:
+        c.close()
+    whole = evaluation_shard(policy.module[0].module, shard=None, **kw)
+    assert len(whole) == 4 and sorted(split, key=lambda t: t["object"]) == sorted(whole, key=lambda t: t["object"])

@@ -21,6 +21,16 @@ def test_same_seed_same_results(grasp_file, tiny_objects):
     assert json.dumps(a) != json.dumps(c)
 
 
+def test_shards_together_give_the_unsharded_trials(grasp_file, tiny_objects):
+    """Evaluation split over workers (objects i mod n) does not change any trial."""
+    kw = dict(grasp_dataset=grasp_file, trials_per_object=1, seed=3, progress=False)
+    whole = E.run_protocol("relocate", E.zero_policy, tiny_objects, **kw)
+    parts = [t for i in range(3) for t in E.run_protocol("relocate", E.zero_policy, tiny_objects, shard=(i, 3), **kw)]
+    order = {o.name: i for i, o in enumerate(tiny_objects)}
+    parts.sort(key=lambda t: (order[t["object"]], t["trial"]))
+    assert len(whole) == 4 and json.dumps(parts) == json.dumps(whole)
+
+
 def test_scripted_relocation_baseline_table(grasp_file, tiny_objects):
     trials = E.run_protocol("relocate", E.scripted_relocate_policy, tiny_objects, trials_per_object=2,
                             grasp_dataset=grasp_file, progress=False)

@@ -23,7 +23,7 @@ paper's naive relocation baseline). Same seed and policy give identical results.
 from __future__ import annotations
 
 import logging
-from typing import Callable, Dict, List, Optional, Sequence
+from typing import Callable, Dict, List, Optional, Sequence, Tuple
 
 import gymnasium as gym
 import torch
@@ -153,10 +153,12 @@ def run_protocol(protocol: str, policy: PolicyFn, objects: Sequence[ObjectSpec],
                  trials_per_object: int = 25, seed: int = 0, disturb: bool = False, randomize: bool = False,
                  grasp_dataset=None, original: bool = False, progress: bool = True,
                  videos: int = 0, video_dir=None, ablation: Optional[dict] = None,
-                 axes: Optional[Sequence[str]] = None) -> List[dict]:
+                 axes: Optional[Sequence[str]] = None, shard: Optional[Tuple[int, int]] = None) -> List[dict]:
     """All trials of one protocol; returns one dict per trial. The first ``videos`` trials are
     recorded as trajectory files (and rendered to mp4) in ``video_dir``. ``axes`` restricts
-    rotate/translate to some of the protocol's axes (default: all)."""
+    rotate/translate to some of the protocol's axes (default: all). ``shard=(i, n)`` runs only the
+    objects whose index is i modulo n; every trial is seeded from its object's index in the whole
+    list, so n shards together give exactly the trials of one unsharded run."""
     if protocol not in PROTOCOLS:
         raise ValueError(f"unknown protocol {protocol!r}; valid: {list(PROTOCOLS)}")
     bad = [a for a in (axes or []) if a not in AXES[protocol]]
@@ -182,9 +184,11 @@ def run_protocol(protocol: str, policy: PolicyFn, objects: Sequence[ObjectSpec],
             objs = [o for o in objs if o.name in have]
     steps = STEPS[protocol]
     trials = []
-    total = len(objs) * len(axes) * trials_per_object
+    mine = [oi for oi in range(len(objs)) if shard is None or oi % shard[1] == shard[0]]
+    total = len(mine) * len(axes) * trials_per_object
     bar = tqdm(total=total, desc=f"eval {protocol}", disable=not progress)
-    for oi, obj in enumerate(objs):
+    for oi in mine:
+        obj = objs[oi]
         for axis in axes:
             env = _env_for(protocol, axis, obj, hand, disturb, randomize, grasp_dataset, original, ablation)
             u = env.unwrapped

@@ -133,8 +133,12 @@ def _worker(rank: int, env_id: str, env_kwargs: dict, seed: int, deterministic: 
         if cmd == "close":
             break
         try:
-            rollout.collect(row)
-            conn.send(("done", None))
+            if cmd == "collect":
+                rollout.collect(row)
+                conn.send(("done", None))
+            else:  # ("call", fn, kwargs): fn(actor, **kwargs) with the worker's actor
+                _, fn, kwargs = cmd
+                conn.send(("done", fn(rollout.actor, **kwargs)))
         except Exception:
             conn.send(("error", traceback.format_exc()))
     rollout.close()
@@ -219,6 +223,17 @@ class LeanCollector:
                 conn.send("collect")
             self._wait("done")
         return self.buf.clone()
+
+    def map_shards(self, fn, **kwargs) -> list:
+        """``fn(actor, shard=(i, n), **kwargs)`` in each of the n workers (their envs idle), e.g. an
+        evaluation split over objects; returns the n results. One env in the main process: one call
+        with ``shard=None``. ``fn`` must be a module-level function (it is pickled)."""
+        if self._local is not None:
+            return [fn(self._local.actor, shard=None, **kwargs)]
+        n = len(self._conns)
+        for rank, conn in enumerate(self._conns):
+            conn.send(("call", fn, dict(kwargs, shard=(rank, n))))
+        return self._wait("done")
 
     def close(self) -> None:
         if self._local is not None:

@@ -62,7 +62,13 @@ def act(policy, obs: dict, deterministic: bool = True) -> torch.Tensor:
     """Action [N, A] of ``policy`` (a :func:`make_models` actor) for a UniCross ``state_dict``
     observation: the Gaussian's mean, or a sample of it, clipped to [-1, 1]. Calls the network
     directly (the TensorDict actor costs ~2 ms per call on a CPU, the network ~0.3 ms)."""
-    loc, scale = policy.module[0].module(*split_obs(obs))
+    return actor_action(policy.module[0].module, obs, deterministic)
+
+
+@torch.no_grad()
+def actor_action(actor, obs: dict, deterministic: bool = True) -> torch.Tensor:
+    """:func:`act` for the bare network ``(hand, object, goal) -> (loc, scale)``."""
+    loc, scale = actor(*split_obs(obs))
     if not deterministic:
         loc = loc + scale * torch.randn_like(loc)
     return loc.clamp(-1.0, 1.0)

@@ -116,6 +116,17 @@ def env_kwargs_for(skill: str, axis: Optional[str], hand: str, env_cfg: dict) ->
     return kw
 
 
+def evaluation_shard(actor, skill: str, objects: str, limit, trials_per_object: int, seed: int, hand: str,
+                     axis: Optional[str], ablation: Optional[dict], shard) -> list:
+    """One worker's share of a held-out evaluation (see :meth:`PPOTrainer._protocol`)."""
+    from unicross import evaluation as E
+    from unicross.objects import get_object_set
+    from unicross.rl.policy_io import actor_action
+    return E.run_protocol(skill, lambda obs, u: actor_action(actor, obs), get_object_set(objects, limit=limit),
+                          hand=hand, trials_per_object=trials_per_object, seed=seed, progress=False,
+                          axes=[axis] if axis else None, ablation=ablation, shard=shard)
+
+
 class PPOTrainer:
     """One expert: ``skill`` (+ ``axis`` for rotate/translate) on ``hand``."""
 
@@ -214,22 +225,21 @@ class PPOTrainer:
 
     # ------------------------------------------------------------------ evaluation
     @torch.no_grad()
-    def _protocol(self, objects: str, limit, trials_per_object: int, seed: int, progress: bool = False):
+    def _protocol(self, objects: str, limit, trials_per_object: int, seed: int):
         """(trials, summary) of the paper's protocol for this expert's skill (and axis) on the first
-        ``limit`` objects per group of ``objects``, deterministic actions, in its own in-process env
-        (not the training workers), with the run's ablation switches."""
+        ``limit`` objects per group of ``objects``, deterministic actions, with the run's ablation
+        switches: run by the collector's env workers (objects split between them; trials are seeded
+        per object, so the result does not depend on the number of workers) in envs of their own."""
         from unicross import evaluation as E
         from unicross.objects import get_object_set
-        from unicross.rl.policy_io import act
         objs = get_object_set(objects, limit=limit)
-        self.policy.eval()
-        try:
-            trials = E.run_protocol(self.skill, lambda obs, u: act(self.policy, obs), objs, hand=self.hand,
-                                    trials_per_object=trials_per_object, seed=seed, progress=progress,
-                                    axes=[self.axis] if self.axis else None,
-                                    ablation=(self.cfg["env"].get("task_config") or {}).get("ablation"))
-        finally:
-            self.policy.train()
+        shards = self.collector.map_shards(
+            evaluation_shard, skill=self.skill, objects=objects, limit=limit, trials_per_object=trials_per_object,
+            seed=seed, hand=self.hand, axis=self.axis, ablation=(self.cfg["env"].get("task_config") or {}).get("ablation"))
+        order = {o.name: i for i, o in enumerate(objs)}
+        axes = E.AXES[self.skill]
+        trials = sorted((t for shard in shards for t in shard),
+                        key=lambda t: (order[t["object"]], axes.index(t["axis"]) if t["axis"] else 0, t["trial"]))
         return trials, E.summarize(self.skill, trials)
 
     def evaluate(self) -> dict:
@@ -413,8 +423,10 @@ class PPOTrainer:
         in the format of ``unicross eval``."""
         from unicross import evaluation as E
         lc = self.cfg["logging"]
-        trials, summ = self._protocol(lc["final_eval_objects"], lc["final_eval_limit"], lc["final_eval_trials"],
-                                      seed=0, progress=self.progress)
+        if self.progress:
+            print(f"final evaluation: {self.skill} protocol on {lc['final_eval_objects']} objects "
+                  f"(first {lc['final_eval_limit']} per group x {lc['final_eval_trials']} trials) ...", flush=True)
+        trials, summ = self._protocol(lc["final_eval_objects"], lc["final_eval_limit"], lc["final_eval_trials"], seed=0)
         label = f"{self.skill}{'_' + self.axis if self.axis else ''} expert"
         result = dict(label=label, policy=dict(kind="checkpoint", path=str(self.run_dir / CKPT_NAME),
                                                skill=self.skill, axis=self.axis, git_commit=self.commit),
