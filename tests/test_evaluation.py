@@ -102,3 +102,16 @@ def test_cli_eval_and_report(tmp_path, grasp_file):
     assert r["summaries"]["grasp"]["n"] == 2 and len(r["trials"]["grasp"]) == 2
     assert cli(["report", str(out), "--out", str(tmp_path / "t.md")]) == 0
     assert "Grasp SR" in (tmp_path / "t.md").read_text()
+
+
+def test_cli_eval_gives_the_same_trials_on_any_number_of_workers(tmp_path, grasp_file):
+    """`unicross eval --workers 2` splits the objects over processes; every trial (random actions
+    included: their stream restarts from each trial's seed) is the one a single process gives."""
+    out = {}
+    for w in (1, 2):
+        path = tmp_path / f"w{w}.json"
+        assert cli(["eval", "--policy", "random", "--protocol", "translate", "--objects", "train", "--limit", "1",
+                    "--trials-per-object", "2", "--grasps", str(grasp_file), "--workers", str(w), "--seed", "3",
+                    "--out", str(path)]) == 0
+        out[w] = json.loads(path.read_text())["trials"]
+    assert len(out[1]["translate"]) == 8 and out[1] == out[2]

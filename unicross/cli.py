@@ -236,17 +236,18 @@ def _cmd_eval(args) -> int:
     if bad:
         raise ValueError(f"unknown protocol(s) {bad}; valid: {list(E.PROTOCOLS)} or 'all'")
     objs = get_object_set(args.objects, limit=args.limit)
-    policy, desc = E.resolve_policy(args.policy, args.hand, seed=args.seed)
+    _, desc = E.resolve_policy(args.policy, args.hand, seed=args.seed)  # checks the checkpoint before simulating
     label = args.label or Path(args.policy).stem
     result = dict(label=label, policy=desc, objects=args.objects, limit=args.limit, hand=args.hand,
                   trials_per_object=args.trials_per_object, seed=args.seed, disturb=args.disturb,
                   original=args.original, randomize=args.randomize, summaries={}, trials={})
     for p in protocols:
-        trials = E.run_protocol(p, policy, objs, hand=args.hand, trials_per_object=args.trials_per_object,
-                                seed=args.seed, disturb=args.disturb, randomize=args.randomize,
-                                grasp_dataset=args.grasps, original=args.original, videos=args.videos,
-                                video_dir=Path(args.out).parent / (Path(args.out).stem + "_videos"),
-                                ablation=desc.get("ablation"))
+        trials = E.run_protocol_workers(p, args.policy, objs, hand=args.hand, workers=args.workers, seed=args.seed,
+                                        trials_per_object=args.trials_per_object, disturb=args.disturb,
+                                        randomize=args.randomize, grasp_dataset=args.grasps, original=args.original,
+                                        videos=args.videos,
+                                        video_dir=Path(args.out).parent / (Path(args.out).stem + "_videos"),
+                                        ablation=desc.get("ablation"))
         result["trials"][p] = trials
         result["summaries"][p] = E.summarize(p, trials)
     out = Path(args.out)
@@ -307,7 +308,7 @@ def _cmd_chain(args) -> int:
     if args.sequence:
         parse_sequence(args.sequence)  # validates before any simulation
     objs = get_object_set(args.objects, limit=args.limit)
-    policy, desc = E.resolve_policy(args.policy, args.hand, seed=args.seed)
+    _, desc = E.resolve_policy(args.policy, args.hand, seed=args.seed)  # checks the checkpoint before simulating
     videos = 1 if args.video else 0
     video_dir = Path(args.video).parent if args.video else None
     trials = E.run_chain(policy, objs, args.sequence, hand=args.hand, trials_per_object=args.trials_per_object,
@@ -378,6 +379,8 @@ def main(argv=None) -> int:
     s.add_argument("--seed", type=int, default=0)
     s.add_argument("--label", default=None, help="row label in tables (default: the policy name)")
     s.add_argument("--videos", type=int, default=0, help="record and render the first K trials of each protocol")
+    s.add_argument("--workers", type=int, default=1,
+                   help="processes to split the objects over (same trials for any number; one env per process)")
     s.add_argument("--out", required=True)
     s.set_defaults(fn=_cmd_eval)
     s = sub.add_parser("report", help="assemble eval JSON files into the paper's table layout")

@@ -53,9 +53,13 @@ def zero_policy(obs, u) -> torch.Tensor:
 
 
 def make_random_policy(seed: int) -> PolicyFn:
-    g = torch.Generator().manual_seed(seed)
+    """Uniform random actions; the stream restarts at each episode from ``seed`` and the episode's
+    seed, so a trial's actions do not depend on the trials run before it (or on sharding)."""
+    g = torch.Generator()
 
     def policy(obs, u):
+        if int(u.elapsed_steps[0]) == 0:
+            g.manual_seed(seed * 1_000_003 + int(u._episode_seed[0]))
         return (torch.rand(u.num_envs, u.hand_spec.dof, generator=g) * 2 - 1).to(u.device)
     return policy
 
@@ -227,6 +231,40 @@ def run_protocol(protocol: str, policy: PolicyFn, objects: Sequence[ObjectSpec],
             env.close()
     bar.close()
     return trials
+
+
+def merge_shards(protocol: str, objects: Sequence[ObjectSpec], parts: Sequence[List[dict]]) -> List[dict]:
+    """The trials of shards of one :func:`run_protocol` call, in the order one unsharded call gives."""
+    order = {o.name: i for i, o in enumerate(objects)}
+    return sorted((t for part in parts for t in part),
+                  key=lambda t: (order[t["object"]], AXES[protocol].index(t["axis"]) if t["axis"] else 0, t["trial"]))
+
+
+def _protocol_shard(spec: str, hand: str, policy_seed: int, protocol: str, objects, kwargs: dict, shard) -> List[dict]:
+    torch.set_num_threads(1)
+    policy, _ = resolve_policy(spec, hand, seed=policy_seed)
+    return run_protocol(protocol, policy, objects, hand=hand, shard=shard, progress=False, **kwargs)
+
+
+def run_protocol_workers(protocol: str, spec: str, objects: Sequence[ObjectSpec], hand: str = "allegro",
+                         workers: int = 1, seed: int = 0, **kwargs) -> List[dict]:
+    """:func:`run_protocol` for the policy named by ``spec`` (as ``unicross eval --policy``), split
+    over ``workers`` spawned processes (objects i mod n). Trials are seeded per object and trial,
+    so the result is the same for any number of workers (tested)."""
+    if workers <= 1:
+        policy, _ = resolve_policy(spec, hand, seed=seed)
+        return run_protocol(protocol, policy, objects, hand=hand, seed=seed, **kwargs)
+    if kwargs.get("videos"):
+        raise ValueError("--videos records the first trials of one process: use --workers 1")
+    import multiprocessing as mp
+    from concurrent.futures import ProcessPoolExecutor
+    kwargs = {k: v for k, v in kwargs.items() if k not in ("progress", "video_dir")}
+    print(f"eval {protocol}: {len(objects)} objects on {workers} worker processes ...", flush=True)
+    with ProcessPoolExecutor(workers, mp_context=mp.get_context("spawn")) as ex:
+        futures = [ex.submit(_protocol_shard, spec, hand, seed, protocol, list(objects), dict(kwargs, seed=seed),
+                             (i, workers)) for i in range(workers)]
+        parts = [f.result() for f in futures]
+    return merge_shards(protocol, objects, parts)
 
 
 def _save_video(rec, video_dir, name: str) -> None:

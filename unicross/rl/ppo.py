@@ -236,10 +236,7 @@ class PPOTrainer:
         shards = self.collector.map_shards(
             evaluation_shard, skill=self.skill, objects=objects, limit=limit, trials_per_object=trials_per_object,
             seed=seed, hand=self.hand, axis=self.axis, ablation=(self.cfg["env"].get("task_config") or {}).get("ablation"))
-        order = {o.name: i for i, o in enumerate(objs)}
-        axes = E.AXES[self.skill]
-        trials = sorted((t for shard in shards for t in shard),
-                        key=lambda t: (order[t["object"]], axes.index(t["axis"]) if t["axis"] else 0, t["trial"]))
+        trials = E.merge_shards(self.skill, objs, shards)
         return trials, E.summarize(self.skill, trials)
 
     def evaluate(self) -> dict:
