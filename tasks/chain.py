@@ -141,7 +141,3 @@ class ChainEnv(UniCrossEnv):
         self.static_skill = F.mode_skill(self.sequence[k])
         self._pending = torch.ones_like(self._pending)
         self._stepped = False
-
-    @property
-    def overall_success(self) -> torch.Tensor:
-        return self.phase_success.all(dim=-1)

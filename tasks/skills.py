@@ -35,7 +35,6 @@ class RotateEnv(UniCrossEnv):
 
     def __init__(self, *args, axis: str = "z+", **kwargs):
         F.mode_index("rotate", axis)  # validates
-        self.skill_axis = axis
         super().__init__(*args, modes=(f"rotate_{axis}",), **kwargs)
 
 
@@ -47,7 +46,6 @@ class TranslateEnv(UniCrossEnv):
 
     def __init__(self, *args, direction: str = "z+", **kwargs):
         F.mode_index("translate", direction)  # validates
-        self.skill_direction = direction
         super().__init__(*args, modes=(f"translate_{direction}",), **kwargs)
 
 

@@ -39,10 +39,6 @@ def translation_series(x_oh: torch.Tensor, axis: torch.Tensor) -> torch.Tensor:
     return ((x_oh - x_oh[:, :1]) * axis[:, None]).sum(-1)
 
 
-def accumulated_translation(x_oh: torch.Tensor, axis: torch.Tensor) -> torch.Tensor:
-    return translation_series(x_oh, axis)[:, -1]
-
-
 def exceeded(series: torch.Tensor, threshold: float) -> torch.Tensor:
     """Whether the accumulated motion went beyond ``threshold`` at any step: [B, T] -> [B]."""
     return series.max(dim=-1).values > threshold

@@ -31,7 +31,6 @@ WRAPPABLE_RANGE = (0.045, 0.075)
 ELONGATED_LENGTH = (0.6, 0.8)
 ELONGATED_WIDTH = (0.045, 0.065)
 SET_SEED = 20240601
-SHAPES = ("box", "cylinder", "sphere", "prism", "mesh")
 
 
 @dataclasses.dataclass(frozen=True)
