@@ -74,3 +74,14 @@ def test_no_teleport_across_the_switch():
     env.step(torch.zeros(22))
     v_next = hand.get_linear_velocity()
     assert (v_next - v_after).norm() < 0.5
+
+
+def test_chain_command_runs_a_policy_and_writes_every_trial(tmp_path):
+    import json
+    from unicross.cli import main as cli
+    out = tmp_path / "chain.json"
+    assert cli(["chain", "--policy", "zero", "--sequence", "grasp,relocate", "--objects", "test-wrappable",
+                "--limit", "1", "--out", str(out)]) == 0
+    r = json.loads(out.read_text())
+    assert r["policy"]["kind"] == "zero" and len(r["trials"]) >= 1
+    assert all(len(t["phase_success"]) == 2 for t in r["trials"])

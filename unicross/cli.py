@@ -308,7 +308,7 @@ def _cmd_chain(args) -> int:
     if args.sequence:
         parse_sequence(args.sequence)  # validates before any simulation
     objs = get_object_set(args.objects, limit=args.limit)
-    _, desc = E.resolve_policy(args.policy, args.hand, seed=args.seed)  # checks the checkpoint before simulating
+    policy, desc = E.resolve_policy(args.policy, args.hand, seed=args.seed)
     videos = 1 if args.video else 0
     video_dir = Path(args.video).parent if args.video else None
     trials = E.run_chain(policy, objs, args.sequence, hand=args.hand, trials_per_object=args.trials_per_object,
