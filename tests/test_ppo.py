@@ -154,3 +154,11 @@ def test_finished_run_evaluates_on_held_out_objects_and_exports(tmp_path):
     assert side["commands"] == ["unicross train ..."] and side["evaluations"][0]["summaries"]["grasp"]["n"] == 4
     policy, ck = load_policy(out)
     assert "optim" not in ck and ck["skill"] == "grasp" and out.stat().st_size < 3e6
+
+
+def test_set_reads_numbers_the_way_users_write_them():
+    from unicross.cli import parse_sets
+    got = parse_sets(["optim.lr_min=1e-5", "optim.lr=3.0e-4", "logging.eval_objects=test", "env.object_limit=null"])
+    assert got == {"optim": {"lr_min": 1e-5, "lr": 3e-4}, "logging": {"eval_objects": "test"},
+                   "env": {"object_limit": None}}
+    assert isinstance(got["optim"]["lr_min"], float)

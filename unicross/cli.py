@@ -145,8 +145,18 @@ def parse_sets(items) -> dict:
         keys = path.split(".")
         for k in keys[:-1]:
             node = node.setdefault(k, {})
-        node[keys[-1]] = yaml.safe_load(value)
+        node[keys[-1]] = _number_or_yaml(value, yaml.safe_load(value))
     return out
+
+
+def _number_or_yaml(text: str, parsed):
+    """YAML 1.1 reads ``1e-5`` (no dot) as a string; a value that reads as a float is a float."""
+    if isinstance(parsed, str):
+        try:
+            return float(text)
+        except ValueError:
+            pass
+    return parsed
 
 
 def overrides_from(args, **flags) -> dict:
