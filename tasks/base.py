@@ -450,9 +450,11 @@ class UniCrossEnv(BaseEnv):
 
     def reset(self, seed=None, options=None):
         self._seeded_reset = seed is not None
-        if seed is not None and self.reconfiguration_freq and len(self._pairs) > self.num_envs:
-            # a seeded reset replays its episode: the object (and its mass and friction) must come
-            # from the seed too, not from wherever the rebuild cursor stands
+        if seed is not None and self.scene is not None and not self.gpu_sim_enabled and \
+                (self.cfg["randomization"]["enabled"] or len(self._pairs) > self.num_envs):
+            # a seeded reset replays its episode: the object and its mass and friction (drawn when
+            # the scene is built) must come from the seed too, not from an earlier build or from
+            # wherever the rebuild cursor stands (CPU: a rebuild costs ~0.02 s)
             options = dict(options or {})
             options.setdefault("reconfigure", True)
         obs, info = super().reset(seed=seed, options=options)

@@ -91,15 +91,18 @@ def test_unseeded_resets_differ_and_seeded_resets_repeat_the_start(env_id, kw):
 
 @pytest.mark.parametrize("env_id,kw", [("UniCross-Grasp-v1", {}), ("UniCross-Relocate-v1", {}),
                                        ("UniCross-Rotate-v1", dict(axis="x-")),
-                                       ("UniCross-Translate-v1", dict(direction="z+"))])
+                                       ("UniCross-Translate-v1", dict(direction="z+")),
+                                       ("UniCross-Relocate-v1", dict(object_limit=1, reconfiguration_freq=0))])
 def test_seeded_episode_replays_exactly_with_randomisation_and_rebuilds(env_id, kw):
     """A seeded reset replays its whole episode (object, mass, friction, start, noise and
-    perturbations, physics) whatever ran before it, on the full object set with scene rebuilds."""
-    env = gym.make(env_id, randomize=True, reconfiguration_freq=4, obs_mode="state_dict", sim_backend="physx_cpu",
-                   render_backend="none", **kw)
-    u = env.unwrapped
+    perturbations, physics) whatever ran before it, in the same env or in a new one: on the full
+    object set with scene rebuilds, and in an env that never rebuilds by itself (its mass and
+    friction, drawn when the scene is built, come from the seed too)."""
+    def make():
+        return gym.make(env_id, **{**dict(randomize=True, reconfiguration_freq=4, obs_mode="state_dict",
+                                          sim_backend="physx_cpu", render_backend="none"), **kw}).unwrapped
 
-    def episode(seed=5, action_seed=1, steps=60):
+    def episode(u, seed=5, action_seed=1, steps=60):
         u.reset(seed=seed)
         g = torch.Generator().manual_seed(action_seed)
         out = []
@@ -107,13 +110,17 @@ def test_seeded_episode_replays_exactly_with_randomisation_and_rebuilds(env_id, 
             obs, r, *_ = u.step((torch.rand(1, u.hand_spec.dof, generator=g) * 2 - 1) * 0.3)
             out.append(torch.cat([obs["extra"]["hand"], obs["extra"]["goal"], r[:, None]], -1))
         return torch.cat(out)
-    first = episode()
-    episode(seed=9, action_seed=3, steps=30)  # something else in between: another seeded episode ...
-    for _ in range(3):  # ... and unseeded ones that move the rebuild cursor
+    u = make()
+    for _ in range(3):  # unseeded episodes first: they move the rebuild cursor and the generators
         u.reset()
         u.step(torch.zeros(1, u.hand_spec.dof))
-    assert torch.equal(episode(), first)
-    env.close()
+    first = episode(u)
+    episode(u, seed=9, action_seed=3, steps=30)  # another seeded episode in between
+    assert torch.equal(episode(u), first)
+    u.close()
+    other = make()  # a new env (its first scene built without a seed)
+    assert torch.equal(episode(other), first)
+    other.close()
 
 
 def test_untrained_policy_acts_near_zero_and_normaliser_skips_nonfinite_rows():
