@@ -596,6 +596,11 @@ class UniCrossEnv(BaseEnv):
         # velocities and accumulated motion over the last control step
         dt = self.control_dt
         (xp, qp), (xc, qc) = self.prev_rel.poses(), cur.poses()
+        # the object's error to its final root-frame pose before and after the step (r_progress)
+        goal_err_prev = torch.stack([torch.linalg.norm(self.prev_rel.x_or - self.final_x_or, dim=-1),
+                                     quat_angle(self.prev_rel.q_or, self.final_q_or)], dim=-1)
+        goal_err = torch.stack([torch.linalg.norm(cur.x_or - self.final_x_or, dim=-1),
+                                quat_angle(cur.q_or, self.final_q_or)], dim=-1)
         vel, angvel = F.finite_velocity(xp[:, ::2], qp[:, ::2], xc[:, ::2], qc[:, ::2], dt)  # object in hand, hand in root
         v, w, hv, hw = vel[:, 0], angvel[:, 0], vel[:, 1], angvel[:, 1]
         p1 = pend[:, None]
@@ -656,7 +661,8 @@ class UniCrossEnv(BaseEnv):
         meas = dict(link_distance=dist, contact=contact, force_clipped=force_c, speed_along_axis=speed,
                     speed_cap=self._speed_cap[self.mode], relational=cur, reward_targets=reward_targets,
                     finger_qpos=m["qpos"][:, 6:], finger_qpos0=self.finger_q0, hand_lin_vel=self.hand_vel,
-                    hand_ang_vel=self.hand_angvel, finger_torque=m["finger_torque"], drop=drop, success=success)
+                    hand_ang_vel=self.hand_angvel, finger_torque=m["finger_torque"], drop=drop, success=success,
+                    goal_err_prev=goal_err_prev, goal_err=goal_err)
         terms = self.rewards(self.mode, meas)
         self._obs_parts = dict(qpos=m["qpos"], contact=contact, force=force_c, vec=m["link_vec"])
         info = dict(success=success, fail=drop, drop=drop, ever_dropped=self.ever_dropped.clone(),

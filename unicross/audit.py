@@ -15,11 +15,11 @@ Grasp behaviours (scripted on the task's own state, through the normal action in
   zero           no action
   random         uniform random actions
 
-Relocate: ``follow`` (the successful reference: zero wrist residual, so the wrist follows the
-task's interpolated target, with the grasp's fingers tightened by 0.1 rad to hold the object),
-``follow_loose`` (the same with zero finger action), ``naive`` (the paper's naive baseline: wrist
-driven straight to the goal, fingers tightened), ``stay`` (the wrist holds its start pose) and
-``random``.
+Relocate: ``follow`` (the successful reference: the zero action, so the wrist follows the task's
+interpolated target and the fingers hold the grasp), ``follow_tight`` (the same with the fingers
+tightened by 0.1 rad, as the naive baseline holds them), ``naive`` (the paper's naive baseline:
+wrist driven straight to the goal, fingers tightened), ``stay`` (the wrist holds its start pose)
+and ``random``.
 
 Rotate and translate: ``oracle``, ``zero``, ``random``. The oracle is a kinematic reference:
 the hand holds still (zero action) and, after each control step's physics, the object is placed
@@ -84,8 +84,8 @@ def _stay(u):
 
 
 def _follow_relocate(u):
-    """The relocate reference: the wrist follows its Tracked reference (zero residual) while the
-    fingers hold the grasp slightly tightened (as the paper's naive baseline does)."""
+    """The wrist follows its Tracked reference (zero residual) while the fingers hold the grasp
+    slightly tightened (as the paper's naive baseline does)."""
     from unicross.evaluation import tightened_fingers_action
     return lambda: tightened_fingers_action(u)
 
@@ -133,7 +133,7 @@ def behaviours(skill: str, seed: int = 0) -> Dict[str, Callable]:
                     hover=_grasp_script(lift=False, close=False, descend=True),
                     close_only=_grasp_script(lift=False, close=True, descend=False), **common)
     if skill == "relocate":
-        return dict(follow=_follow_relocate, follow_loose=_zero, naive=_naive_relocate, stay=_stay,
+        return dict(follow=_zero, follow_tight=_follow_relocate, naive=_naive_relocate, stay=_stay,
                     random=common["random"])
     if skill in ("rotate", "translate"):
         return dict(oracle=_oracle, **common)

@@ -2,7 +2,8 @@
 
 ``r = r_goal + r_track + r_reg`` with
   r_goal  = contact + motion (+ success: ours, a per-step bonus while the mode's success holds;
-            0 in the paper, see configs/reward.yaml)
+            + progress: ours, the decrease of the object's error to its final pose (relocate);
+            both 0 in the paper, see configs/reward.yaml)
   r_track = Σ w · error over the six relational poses (position errors saturate at ``track.max_pos_error``)
   r_reg   = pose + wrist_velocity + energy + drop
 
@@ -20,7 +21,7 @@ import torch
 from unicross.formulation import MODES, Relational, mode_skill
 from unicross.geometry import quat_angle
 
-TERMS = ("contact", "motion", "success", "track", "pose", "wrist_velocity", "energy", "drop")
+TERMS = ("contact", "motion", "success", "progress", "track", "pose", "wrist_velocity", "energy", "drop")
 TRACK_WEIGHTS = dict(x_or="w_opr", q_or="w_oqr", x_oh="w_oph", q_oh="w_oqh", x_hr="w_hpr", q_hr="w_hqr")
 
 
@@ -55,6 +56,16 @@ def success_reward(success: torch.Tensor, w_success: torch.Tensor) -> torch.Tens
     return w_success * success.float()
 
 
+def progress_reward(err_prev: torch.Tensor, err: torch.Tensor, w_pos: torch.Tensor, w_rot: torch.Tensor,
+                    max_pos: float = float("inf")) -> torch.Tensor:
+    """w_pos·(e_{t-1} − e_t) + w_rot·(θ_{t-1} − θ_t): how much closer the object came to its final
+    pose over the step (``err`` [B, 2]: position error, saturated at ``max_pos``, and angle). A
+    potential-based shaping term (Ng et al., 1999, with γ≈1): over an episode it sums to the
+    reduction of the error from start to end, whatever the path."""
+    pos_prev, pos = err_prev[:, 0].clamp(max=max_pos), err[:, 0].clamp(max=max_pos)
+    return w_pos * (pos_prev - pos) + w_rot * (err_prev[:, 1] - err[:, 1])
+
+
 def pose_reward(finger_q: torch.Tensor, finger_q0: torch.Tensor, w_pose: float) -> torch.Tensor:
     """w_pose · Σ (q_i - q_i,0)² over finger joints."""
     return w_pose * ((finger_q - finger_q0) ** 2).sum(-1)
@@ -84,6 +95,8 @@ class RewardTerms:
         self.w_p = per_mode(lambda s: cfg["motion"][s])
         self.max_distance = float(cfg["contact_max_distance"])
         self.w_success = per_mode(lambda s: cfg["success"][s])
+        self.w_prog_pos = per_mode(lambda s: cfg["progress"][s]["w_pos"])
+        self.w_prog_rot = per_mode(lambda s: cfg["progress"][s]["w_rot"])
         t = cfg["track"]
         self.max_pos = float(t["max_pos_error"])
         self.track_pos = torch.tensor([t[TRACK_WEIGHTS[s]] for s in ("x_oh", "x_or", "x_hr")], device=device)
@@ -98,6 +111,8 @@ class RewardTerms:
                                    self.w_dis[mode], self.w_con[mode], self.w_f[mode], self.max_distance),
             motion=motion_reward(m["speed_along_axis"], m["speed_cap"], self.w_p[mode]),
             success=success_reward(m["success"], self.w_success[mode]),
+            progress=progress_reward(m["goal_err_prev"], m["goal_err"], self.w_prog_pos[mode],
+                                     self.w_prog_rot[mode], self.max_pos),
             track=tracking_reward(m["relational"], m["reward_targets"], self.track_pos, self.track_rot,
                                   self.max_pos),
             pose=pose_reward(m["finger_qpos"], m["finger_qpos0"], self.reg["w_pose"]),
