@@ -43,14 +43,14 @@ def main(argv=None) -> int:
         evals, train = load(run)
         if evals:
             f = [r["frames"] for r in evals]
-            line, = a.plot(f, [100 * r["eval_success"] for r in evals], marker="o", ms=3, label=run.name)
+            line, = a.plot(f, [100 * r["eval_success"] for r in evals], marker="o", ms=3,
+                           label=f"{run.name} (n={evals[0]['eval_n']})")
             a.fill_between(f, [100 * r["eval_ci95_low"] for r in evals], [100 * r["eval_ci95_high"] for r in evals],
                            color=line.get_color(), alpha=0.12)
         if train:
             b.plot([r["frames"] for r in train], smooth([r["episode_return"] for r in train]), label=run.name)
-    n = evals[0]["eval_n"] if evals else 0
     a.set(xlabel="frames", ylabel="success (%)", ylim=(-2, 102),
-          title=f"held-out evaluation (paper protocol, n={n} each, 95% CI)")
+          title="held-out evaluation (paper protocol, 95% CI)")
     b.set(xlabel="frames", ylabel="episode return (raw, smoothed)", title="training episodes")
     for ax in (a, b):
         ax.grid(alpha=0.3)
