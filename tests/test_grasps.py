@@ -14,10 +14,15 @@ def test_scripted_grasps_hold_for_two_seconds():
     assert stats["success_rate"] >= 0.8
     held = hold_test("allegro", gs, objs, seconds=2.0)
     assert len(held) == len(gs) and sum(held) / len(held) >= 0.8
-    # the dataset describes physically settled grasps: fingers near their PD targets (a squeezing
-    # finger sits up to ~0.6 rad short of its target; the sample depends on the task generator's draws)
-    gap = (gs.data["finger_qpos"] - gs.data["finger_target"]).abs()
-    assert gap.max() < 0.7 and gap.mean() < 0.2
+    # the dataset describes physically settled grasps: fingers at rest near their PD targets, except
+    # those pressed against the object, which sit short of their closing target (by how much depends on
+    # where the object lies in the hand, i.e. on the task generator's draws: 0.3-0.9 rad seen); no
+    # joint is pushed past its target, which a stored command or an unsettled pose would show
+    signed = gs.data["finger_qpos"] - gs.data["finger_target"]
+    assert signed.abs().mean() < 0.2
+    assert signed.max() < 0.2, "a finger sits beyond its closing target"
+    pressed = signed < -0.2
+    assert (gs.data["finger_target"][pressed] > 0.5).all(), "a large gap on a joint that is not closing"
 
 
 def test_grasp_set_round_trip(tmp_path, grasp_file):
