@@ -30,9 +30,10 @@ from mani_skill.utils.structs.pose import Pose
 from mani_skill.utils.structs.types import SimConfig
 
 from unicross import formulation as F
+from unicross.compiling import compile_enabled, maybe_compile
 from unicross.config import load_config
 from unicross.geometry import (
-    closest_point_shapes, pose_mul, quat_apply, quat_from_axis_angle, quat_from_euler_xyz, quat_from_matrix,
+    SHAPE_BOX, SHAPE_CYLINDER, SHAPE_MESH, SHAPE_PRISM, SHAPE_SPHERE, closest_point_shapes, pose_mul, quat_apply, quat_from_axis_angle, quat_from_euler_xyz, quat_from_matrix,
     quat_angle, quat_inv, quat_mul, quat_positive, relative_pose,
 )
 from unicross.grasps import GraspSet, default_grasp_path
@@ -114,6 +115,7 @@ class UniCrossEnv(BaseEnv):
                  config: Optional[dict] = None, reward_config: Optional[dict] = None,
                  randomize: Optional[bool] = None, robot_uids=None, **kwargs):
         # ---- validate everything before any simulation starts
+        self._step_math = maybe_compile(self._step_math_eager)  # UNICROSS_COMPILE (unicross/compiling.py)
         self.hand_spec: HandSpec = load_hand(hand)
         if hand_overrides:
             import dataclasses
@@ -249,6 +251,10 @@ class UniCrossEnv(BaseEnv):
             fmax = max(len(t) for t in tri)
             tri = [np.concatenate([t, np.repeat(t[:1], fmax - len(t), 0)]) for t in tri]
             self.obj_tris = torch.tensor(np.stack(tri), device=dev)
+        # the closest-point formulas to evaluate: eagerly only the kinds present; compiled, every kind
+        # (selected per env in the fused graph), so one graph serves every object the process builds
+        self._closest_kinds = self.shape_kinds if not compile_enabled() else \
+            frozenset({SHAPE_BOX, SHAPE_CYLINDER, SHAPE_SPHERE, SHAPE_PRISM} | ({SHAPE_MESH} if meshes else set()))
 
     def _after_reconfigure(self, options: dict):
         spec, robot, dev = self.hand_spec, self.agent.robot, self.device
@@ -565,8 +571,18 @@ class UniCrossEnv(BaseEnv):
         self._substep += 1
 
     # ------------------------------------------------------------------ evaluation (single source of truth)
-    def _measure(self) -> Dict[str, torch.Tensor]:
+    def _read(self):
+        """The step's reads from the simulator: tracked body poses, the links' contact forces with the
+        object (only after a physics step; otherwise the last ones are kept), joint positions and
+        velocities. Everything after the reads is tensor math (``_step_math``)."""
         pos, quat = self.sensor.poses()
+        if self._stepped:
+            self.link_force = torch.linalg.norm(self.sensor.contact_forces(), dim=-1)
+            self._stepped = False
+        robot = self.agent.robot
+        return pos, quat, self.link_force, robot.get_qpos(), robot.get_qvel()
+
+    def _measure(self, pos, quat, force, qpos, qvel) -> Dict[str, torch.Tensor]:
         hand_p, hand_q = pos[:, 0], quat[:, 0]
         link_p, link_q = pos[:, 1:-1], quat[:, 1:-1]
         obj_p, obj_q = pos[:, -1], quat[:, -1]
@@ -574,23 +590,30 @@ class UniCrossEnv(BaseEnv):
         probe_w = link_p + quat_apply(link_q, self.link_probe.expand(self.num_envs, L, 3))
         inv_q = quat_inv(obj_q)[:, None].expand(-1, L, 4)
         probe_o = quat_apply(inv_q, probe_w - obj_p[:, None])
-        closest_o = closest_point_shapes(probe_o, self.obj_shape, self.obj_params, self.obj_tris, self.shape_kinds)
+        closest_o = closest_point_shapes(probe_o, self.obj_shape, self.obj_params, self.obj_tris, self._closest_kinds)
         vec_w = quat_apply(obj_q[:, None].expand(-1, L, 4), closest_o - probe_o)  # link -> surface, world axes
         vec_h = quat_apply(quat_inv(hand_q)[:, None].expand(-1, L, 4), vec_w)      # ... in the hand frame
-        if self._stepped:  # contact forces exist only after a physics step; otherwise keep the last ones
-            self.link_force = torch.linalg.norm(self.sensor.contact_forces(), dim=-1)
-            self._stepped = False
-        force = self.link_force
-        robot = self.agent.robot
-        q = robot.get_qpos()[:, self._qidx]
-        qd = robot.get_qvel()[:, self._qidx]
+        q = qpos[:, self._qidx]
+        qd = qvel[:, self._qidx]
         kp, kd, fl = self._finger_pd
         torque = torch.clamp(kp * (self.command[:, 6:] - q[:, 6:]) - kd * qd[:, 6:], -fl, fl)
         return dict(hand_p=hand_p, hand_q=hand_q, obj_p=obj_p, obj_q=obj_q, link_vec=vec_h,
-                    link_distance=torch.linalg.norm(vec_h, dim=-1), force=force, qpos=q, finger_torque=torque)
+                    link_distance=torch.linalg.norm(vec_h, dim=-1), force=force, qpos=q,
+                    finger_torque=torque)
 
     def evaluate(self) -> dict:
-        m = self._measure()
+        pend = self._pending
+        info = self._step_math(*self._read(), self.elapsed_steps)
+        if self._obs_noise_on:  # random draws stay outside the compiled math
+            self.obs_noise = torch.where(pend[:, None], self._draw_obs_noise(self.num_envs), self.obs_noise)
+        return info
+
+    def _step_math_eager(self, pos, quat, force, qpos, qvel, elapsed_steps) -> dict:
+        """Everything ``evaluate()`` computes from the step's reads: distances, relational poses,
+        velocities, accumulated motion, drop, success, reward terms, the next targets and the
+        observation parts. Pure tensor math on the task's state (no reads, no random draws), so it
+        compiles to one graph (``UNICROSS_COMPILE``)."""
+        m = self._measure(pos, quat, force, qpos, qvel)
         cur = F.relational_poses(self.root_p, self.root_q, m["hand_p"], m["hand_q"], m["obj_p"], m["obj_q"])
         pend = self._pending
         # velocities and accumulated motion over the last control step
@@ -621,7 +644,7 @@ class UniCrossEnv(BaseEnv):
         drop = dist.min(dim=-1).values > self.cfg["drop_threshold"]
         # a grasp can only drop what it lifted: before the lift phase the object rests on the table
         lift_after = self.cfg["grasp"]["lift_after"]
-        grasp_lifting = (self.elapsed_steps >= lift_after) if lift_after is not None else torch.zeros_like(drop)
+        grasp_lifting = (elapsed_steps >= lift_after) if lift_after is not None else torch.zeros_like(drop)
         drop = drop & ((skill != 0) | grasp_lifting)
         self.ever_dropped = self.ever_dropped | drop
         # advance the targets; after a drop they hold still: a lost object's pose no longer defines
@@ -636,8 +659,6 @@ class UniCrossEnv(BaseEnv):
         self.axis = torch.where(p1, axis, self.axis)
         self.prev_rel = cur.where(pend, self.prev_rel)
         self.cur_rel = cur
-        if self._obs_noise_on:
-            self.obs_noise = torch.where(p1, self._draw_obs_noise(self.num_envs), self.obs_noise)
         self._pending = torch.zeros_like(pend)
         # success (DESIGN §6)
         contact = m["force"] > self.cfg["contact_force_threshold"]

@@ -3,6 +3,9 @@ import os
 import pytest
 
 os.environ.setdefault("UNICROSS_CACHE", os.path.join(os.path.dirname(__file__), "..", ".cache-tests"))
+# the suite runs the step math eagerly (a cold torch.compile costs ~1 min per process);
+# tests/test_compile.py compiles it explicitly and checks the two agree
+os.environ.setdefault("UNICROSS_COMPILE", "0")
 
 
 @pytest.fixture(scope="session")
