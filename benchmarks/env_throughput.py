@@ -3,9 +3,10 @@
 For each id the env steps with small random wrist actions and still fingers from a reset
 (relocate/rotate/translate start from a grasp, so the hand holds the object; grasp runs the
 scripted grasp first so the hand holds it too)
-and we time (a) ``env.step`` and (b) bare physics of the same scene: the same number of PhysX
-substeps per control step with no task code. Both are measured in this one run, interleaved, and
-reported as steps/s and as a ratio.
+and we time (a) ``env.step`` with the step math eager (``UNICROSS_COMPILE=0``) and compiled
+(``UNICROSS_COMPILE=1``, after its graph is compiled or loaded from the cache) and (b) bare physics
+of the same scene: the same number of PhysX substeps per control step with no task code. All are
+measured in this one run, interleaved, and reported as steps/s and as ratios to bare physics.
 
 A second table compares the physics settings that decide speed (hand self-collision, contact
 offset) on a holding scene: bare physics control steps/s for each combination.
@@ -91,26 +92,37 @@ def main():
     print(f"hand {args.hand}: {len(objects)} objects with a scripted grasp")
     rows = []
     for task, kw in TASKS:
+        built = {}
         try:
-            env, u = _holding_env(task, kw, gs, objects, hand=args.hand)
+            for mode, flag in (("eager", "0"), ("compiled", "1")):  # UNICROSS_COMPILE is read when an env is made
+                os.environ["UNICROSS_COMPILE"] = flag
+                env, u = _holding_env(task, kw, gs, objects, hand=args.hand)
+                _time_env(u, 5)  # the compiled env compiles (or loads its graph) here
+                built[mode] = (env, u, u.get_state_dict())
         except ValueError as e:  # e.g. no elongated grasp for translate
             print(f"{task}: skipped ({e})")
             continue
-        state = u.get_state_dict()
-        env_rates, phys_rates = [], []
+        rates = {m: [] for m in built}
+        phys_rates = []
         for _ in range(3):  # interleave to share machine noise
-            u.set_state_dict(state)
-            rate, commands, joints, contacts = _time_env(u, args.steps)
-            env_rates.append(rate)
-            u.set_state_dict(state)
-            phys_rates.append(_time_physics(u, commands, joints))
-        e, b = max(env_rates), max(phys_rates)
-        rows.append(dict(task=task, env_steps_per_s=round(e, 1), bare_physics_steps_per_s=round(b, 1),
-                         ratio=round(e / b, 3), contacts=round(contacts, 1)))
-        env.close()
-    print(f"{'task':28s} {'env steps/s':>12s} {'bare physics':>13s} {'ratio':>6s} {'links in contact':>17s}")
+            for mode, (env, u, state) in built.items():
+                u.set_state_dict(state)
+                rate, commands, joints, contacts = _time_env(u, args.steps)
+                rates[mode].append(rate)
+                u.set_state_dict(state)
+                phys_rates.append(_time_physics(u, commands, joints))
+        e, c, b = max(rates["eager"]), max(rates["compiled"]), max(phys_rates)
+        rows.append(dict(task=task, eager_steps_per_s=round(e, 1), compiled_steps_per_s=round(c, 1),
+                         bare_physics_steps_per_s=round(b, 1), eager_ratio=round(e / b, 3),
+                         compiled_ratio=round(c / b, 3), contacts=round(contacts, 1)))
+        for env, *_ in built.values():
+            env.close()
+    print(f"{'task':28s} {'eager/s':>8s} {'compiled/s':>11s} {'physics/s':>10s} {'eager ratio':>12s} "
+          f"{'compiled ratio':>15s} {'links in contact':>17s}")
     for r in rows:
-        print(f"{r['task']:28s} {r['env_steps_per_s']:12.0f} {r['bare_physics_steps_per_s']:13.0f} {r['ratio']:6.2f} {r['contacts']:17.1f}")
+        print(f"{r['task']:28s} {r['eager_steps_per_s']:8.0f} {r['compiled_steps_per_s']:11.0f} "
+              f"{r['bare_physics_steps_per_s']:10.0f} {r['eager_ratio']:12.2f} {r['compiled_ratio']:15.2f} "
+              f"{r['contacts']:17.1f}")
     settings = []
     for self_collision, offset in ([(True, 0.02), (True, 0.002), (False, 0.02), (False, 0.002)] if args.settings else []):
         env, u = _holding_env("UniCross-Relocate-v1", {}, gs, objects, hand=args.hand,

@@ -115,7 +115,9 @@ class UniCrossEnv(BaseEnv):
                  config: Optional[dict] = None, reward_config: Optional[dict] = None,
                  randomize: Optional[bool] = None, robot_uids=None, **kwargs):
         # ---- validate everything before any simulation starts
-        self._step_math = maybe_compile(self._step_math_eager)  # UNICROSS_COMPILE (unicross/compiling.py)
+        self._compiled = compile_enabled()  # UNICROSS_COMPILE (unicross/compiling.py), read once per env
+        self._step_math = maybe_compile(self._step_math_eager) if self._compiled else self._step_math_eager
+        self._command_math = maybe_compile(self._command_math_eager) if self._compiled else self._command_math_eager
         self.hand_spec: HandSpec = load_hand(hand)
         if hand_overrides:
             import dataclasses
@@ -253,7 +255,7 @@ class UniCrossEnv(BaseEnv):
             self.obj_tris = torch.tensor(np.stack(tri), device=dev)
         # the closest-point formulas to evaluate: eagerly only the kinds present; compiled, every kind
         # (selected per env in the fused graph), so one graph serves every object the process builds
-        self._closest_kinds = self.shape_kinds if not compile_enabled() else \
+        self._closest_kinds = self.shape_kinds if not self._compiled else \
             frozenset({SHAPE_BOX, SHAPE_CYLINDER, SHAPE_SPHERE, SHAPE_PRISM} | ({SHAPE_MESH} if meshes else set()))
 
     def _after_reconfigure(self, options: dict):
@@ -480,10 +482,14 @@ class UniCrossEnv(BaseEnv):
         art_q[:, self._midx] = self._follow(qpos)
         return art_q
 
-    def _apply_command(self):
-        """PD targets of all driven joints = the current command and its mimic followers (one write
-        on GPU, raw joints on CPU)."""
-        targets = torch.cat([self.command, self._follow(self.command)], dim=-1)
+    def _drive_targets(self) -> torch.Tensor:
+        """PD targets of all driven joints: the current command and its mimic followers."""
+        return torch.cat([self.command, self._follow(self.command)], dim=-1)
+
+    def _apply_command(self, targets: Optional[torch.Tensor] = None):
+        """Write the PD targets of all driven joints (``_drive_targets()`` unless given): one write on
+        GPU, raw joints on CPU."""
+        targets = self._drive_targets() if targets is None else targets
         if self.gpu_sim_enabled:
             self.agent.robot.set_joint_drive_targets(targets, joint_indices=self._drive_idx)
             self.scene.px.gpu_apply_articulation_target_position()
@@ -501,14 +507,9 @@ class UniCrossEnv(BaseEnv):
         a = a.float()
         if not torch.isfinite(a).all():
             raise ValueError("action contains NaN or inf")
-        a = a.clamp(-1.0, 1.0)
-        ref = F.wrist_reference(self.targets)
-        ref[:, :3] = ref[:, :3] + self._advance_lift()
-        self.command = F.map_action(a, self.command, ref, self.action_scale, self.q_lower, self.q_upper,
-                                    wrist_from_target=not self.cfg["ablation"]["no_target_action"])
+        self._apply_command(self._command_math(a, self.elapsed_steps))
         self._pending = torch.ones_like(self._pending)  # evaluate() advances targets once per step
         self._stepped = True
-        self._apply_command()
         obs, reward, _, _, info = super().step(None)  # drive targets are set; ManiSkill runs the substeps
         terminated = info["fail"].clone() if self.cfg["terminate_on_drop"] else torch.zeros_like(info["fail"])
         truncated = self.elapsed_steps >= self.episode_length[self.mode]
@@ -524,14 +525,25 @@ class UniCrossEnv(BaseEnv):
             truncated = truncated | bad
         return obs, reward, terminated, truncated, info
 
-    def _advance_lift(self) -> torch.Tensor:
+    def _command_math_eager(self, a: torch.Tensor, elapsed_steps: torch.Tensor) -> torch.Tensor:
+        """The normalised action [-1, 1] -> this step's joint command (``self.command``; the wrist
+        reference is the target hand pose, raised during the grasp lift) -> the drive targets of all
+        driven joints. Pure tensor math on the task state, compiled like ``_step_math_eager``."""
+        a = a.clamp(-1.0, 1.0)
+        ref = F.wrist_reference(self.targets)
+        ref[:, :3] = ref[:, :3] + self._advance_lift(elapsed_steps)
+        self.command = F.map_action(a, self.command, ref, self.action_scale, self.q_lower, self.q_upper,
+                                    wrist_from_target=not self.cfg["ablation"]["no_target_action"])
+        return self._drive_targets()
+
+    def _advance_lift(self, elapsed_steps: torch.Tensor) -> torch.Tensor:
         """Grasp lift phase: the wrist reference (the Free current wrist pose) rises by
         ``lift_speed * dt`` per step after ``lift_after`` steps; ``self.lift`` accumulates the rise,
         which the Fixed object target follows. Returns this step's increment (root frame)."""
         lift_after = self.cfg["grasp"]["lift_after"]
         if lift_after is None or self.static_skill not in (None, "grasp"):
             return torch.zeros_like(self.lift)
-        lifting = (self.mode == 0) & (self.elapsed_steps >= lift_after)
+        lifting = (self.mode == 0) & (elapsed_steps >= lift_after)
         up_root = quat_apply(quat_inv(self.root_q), self._world_up.expand_as(self.lift))
         step = lifting[:, None].float() * up_root * self.cfg["grasp"]["lift_speed"] * self.control_dt
         self.lift = self.lift + step
@@ -685,7 +697,16 @@ class UniCrossEnv(BaseEnv):
                     hand_ang_vel=self.hand_angvel, finger_torque=m["finger_torque"], drop=drop, success=success,
                     goal_err_prev=goal_err_prev, goal_err=goal_err)
         terms = self.rewards(self.mode, meas)
-        self._obs_parts = dict(qpos=m["qpos"], contact=contact, force=force_c, vec=m["link_vec"])
+        # observation parts (the noise on joint readings is added when observed: it is drawn after this math)
+        ab = self.cfg["ablation"]
+        obs_contact, obs_force = contact.float(), force_c
+        obs_vec = m["link_vec"].reshape(self.num_envs, -1)
+        if ab["no_contact"]:
+            obs_contact, obs_force = torch.zeros_like(obs_contact), torch.zeros_like(obs_force)
+        if ab["no_distance"]:
+            obs_vec = torch.zeros_like(obs_vec)
+        goal = F.goal_features(self.mode, self.axis, cur, self.targets, zero_target=ab["no_target_obs"])
+        self._obs_parts = dict(qpos=m["qpos"], contact=obs_contact, force=obs_force, vec=obs_vec, goal=goal)
         info = dict(success=success, fail=drop, drop=drop, ever_dropped=self.ever_dropped.clone(),
                     lifted=lifted, relocate_pos_err=pos_err, relocate_rot_err=rot_err,
                     rotation=self.rot_acc.clone(), translation=self.trans_acc.clone(),
@@ -699,18 +720,8 @@ class UniCrossEnv(BaseEnv):
 
     def _get_obs_extra(self, info: dict):
         p = self._obs_parts
-        ab = self.cfg["ablation"]
-        q = p["qpos"] + self.obs_noise
-        hand = torch.cat([q, self.command], dim=-1)
-        contact = p["contact"].float()
-        force = p["force"]
-        vec = p["vec"].reshape(self.num_envs, -1)
-        if ab["no_contact"]:
-            contact, force = torch.zeros_like(contact), torch.zeros_like(force)
-        if ab["no_distance"]:
-            vec = torch.zeros_like(vec)
-        goal = F.goal_features(self.mode, self.axis, self.cur_rel, self.targets, zero_target=ab["no_target_obs"])
-        return dict(hand=hand, object=dict(contact=contact, force=force, distance=vec), goal=goal)
+        hand = torch.cat([p["qpos"] + self.obs_noise, self.command], dim=-1)
+        return dict(hand=hand, object=dict(contact=p["contact"], force=p["force"], distance=p["vec"]), goal=p["goal"])
 
     # ------------------------------------------------------------------ reward
     def compute_dense_reward(self, obs: Any, action: torch.Tensor, info: dict):

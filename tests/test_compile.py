@@ -15,7 +15,10 @@ def test_switch(monkeypatch):
     monkeypatch.setenv("UNICROSS_COMPILE", "0")
     assert not compile_enabled() and maybe_compile(f) is f
     monkeypatch.setenv("UNICROSS_COMPILE", "1")
-    assert compile_enabled() and maybe_compile(f) is not f
+    g = maybe_compile(f)
+    assert compile_enabled() and g is not f
+    x = torch.arange(3.0)
+    assert torch.equal(g(x), x + 1) and torch.equal(g(x), x + 1)
 
 
 def _compare(task, kw, grasp_file):
@@ -29,7 +32,17 @@ def _compare(task, kw, grasp_file):
     g = torch.Generator().manual_seed(0)
     for _ in range(3):
         u.step((torch.rand(1, u.hand_spec.dof, generator=g) * 2 - 1) * 0.5)
-    u._pending = torch.ones_like(u._pending)  # the math as right after a physics step
+    # the action -> joint command math
+    a = (torch.rand(1, u.hand_spec.dof, generator=g) * 2 - 1) * 0.5
+    saved = dict(vars(u))
+    eager_targets, eager_command = u._command_math_eager(a, u.elapsed_steps), u.command
+    vars(u).update(saved)
+    targets = torch.compile(u._command_math_eager, fullgraph=True, dynamic=False)(a, u.elapsed_steps)
+    torch.testing.assert_close(targets, eager_targets, atol=1e-5, rtol=1e-5)
+    torch.testing.assert_close(u.command, eager_command, atol=1e-5, rtol=1e-5)
+    vars(u).update(saved)
+    # the math after the reads
+    u._pending = torch.ones_like(u._pending)  # as right after a physics step
     reads = u._read()
     saved = dict(vars(u))
     eager_info = u._step_math_eager(*reads, u.elapsed_steps)
@@ -48,7 +61,7 @@ def _compare(task, kw, grasp_file):
             v, got = v.data, got.data
         if torch.is_tensor(v) and got is not saved.get(k):
             torch.testing.assert_close(got, v, atol=1e-5, rtol=1e-5, msg=lambda m: f"{task} {k}: {m}")
-    for k in ("vec", "force", "qpos"):
+    for k in ("vec", "force", "qpos", "contact", "goal"):
         torch.testing.assert_close(u._obs_parts[k], eager_state["_obs_parts"][k], atol=1e-5, rtol=1e-5)
     env.close()
 

@@ -1,35 +1,59 @@
 """``torch.compile`` for the per-step task math, behind one switch.
 
-``UNICROSS_COMPILE=1`` (the default) compiles the math that follows the simulator's reads in each
-step (``UniCrossEnv._step_math_eager``: ~400 small tensor ops, dispatch-bound on a CPU) into one
-graph with static shapes; ``UNICROSS_COMPILE=0`` runs it eagerly (the test suite does: a cold
-compile costs ~1-2 minutes per process and shape, the on-disk Inductor cache a few seconds after).
-Compiled and eager agree to ~1e-6 per step (tests/test_compile.py).
+``UNICROSS_COMPILE=1`` (the default) compiles the tensor math of each step (``UniCrossEnv.
+_command_math_eager``: action -> joint targets; ``_step_math_eager``: everything ``evaluate()``
+computes after the simulator's reads, ~400 small ops that are dispatch-bound on a CPU) into one
+graph each, with static shapes. ``UNICROSS_COMPILE=0`` runs them eagerly; the test suite does,
+since a cold compile costs about a minute per process (Inductor's on-disk cache, by default under
+``/tmp/torchinductor_$USER`` or ``$TORCHINDUCTOR_CACHE_DIR``, brings later processes to seconds).
+Compiled and eager agree to 1e-5 after a step (tests/test_compile.py).
 """
 from __future__ import annotations
 
+import functools
 import os
+import sys
+import time
 from typing import Callable
 
 import torch
 
-
 RECOMPILE_LIMIT = 64
+_ANNOUNCED = False
 
 
 def compile_enabled() -> bool:
-    """The ``UNICROSS_COMPILE`` switch: on unless set to 0/false/off."""
+    """The ``UNICROSS_COMPILE`` switch: on unless set to 0/false/off/no."""
     return os.environ.get("UNICROSS_COMPILE", "1").strip().lower() not in ("0", "false", "off", "no")
 
 
 def maybe_compile(fn: Callable) -> Callable:
     """``torch.compile(fn, fullgraph=True, dynamic=False)`` when the switch is on, else ``fn``.
-    Compilation is lazy (at the first call) and shape-specialised: each hand (link count) and object
-    shape kind gets its own graph, reused from the on-disk cache by later processes."""
+
+    Compilation is lazy (at the first call) and specialised to the shapes and the task's
+    configuration: one graph per task class, configuration and hand in a process, loaded from the
+    on-disk cache when an earlier process compiled it. The first compile in a process says so on
+    stderr with its duration."""
     if not compile_enabled():
         return fn
-    # one graph per (task class, configuration, shapes) met in a process; an evaluation process can
-    # meet more than Dynamo's default of 8 (every skill, chains, disturbance settings, hands)
+    # an evaluation process can meet more graphs than Dynamo's default of 8 (every skill, chains,
+    # disturbance settings, hands)
     cfg = torch._dynamo.config
     cfg.recompile_limit = max(cfg.recompile_limit, RECOMPILE_LIMIT)
-    return torch.compile(fn, fullgraph=True, dynamic=False)
+    compiled = torch.compile(fn, fullgraph=True, dynamic=False)
+
+    @functools.wraps(fn)
+    def first_call(*args, **kwargs):
+        global _ANNOUNCED
+        if _ANNOUNCED:
+            return compiled(*args, **kwargs)
+        _ANNOUNCED = True
+        print(f"[unicross] compiling the step math with torch.compile (pid {os.getpid()}; about a minute "
+              "the first time, seconds from the cache; UNICROSS_COMPILE=0 runs it eagerly)", file=sys.stderr, flush=True)
+        t = time.perf_counter()
+        out = compiled(*args, **kwargs)
+        print(f"[unicross] step math compiled in {time.perf_counter() - t:.1f} s (pid {os.getpid()})",
+              file=sys.stderr, flush=True)
+        return out
+
+    return first_call
