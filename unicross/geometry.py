@@ -32,10 +32,16 @@ _CACHE: dict = {}
 
 
 def _const(t: torch.Tensor, like: torch.Tensor) -> torch.Tensor:
+    """``t`` on ``like``'s device (and float dtype), cached per (constant, device, dtype) when eager;
+    under torch.compile the conversion is traced into the graph instead (a lookup in the cache
+    would become a guard evaluated in Python at every call)."""
+    dtype = like.dtype if t.is_floating_point() else t.dtype
+    if torch.compiler.is_compiling():
+        return t.to(device=like.device, dtype=dtype)
     key = (id(t), like.device, like.dtype)
     c = _CACHE.get(key)
     if c is None:
-        c = _CACHE[key] = t.to(device=like.device, dtype=like.dtype if t.is_floating_point() else t.dtype)
+        c = _CACHE[key] = t.to(device=like.device, dtype=dtype)
     return c
 
 
