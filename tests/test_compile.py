@@ -74,3 +74,22 @@ def test_compiled_math_matches_eager(grasp_file):
 @pytest.mark.parametrize("task,kw", IDS, ids=[t for t, _ in IDS])
 def test_compiled_math_matches_eager_every_id(task, kw, grasp_file):
     _compare(task, kw, grasp_file)
+
+
+def test_falls_back_to_eager_without_a_compiler(monkeypatch, tmp_path, capsys):
+    """A machine without a working C++ compiler still steps: the compile error is reported once
+    and the math runs eagerly."""
+    import torch._inductor.config as inductor_config
+    monkeypatch.setenv("UNICROSS_COMPILE", "1")
+    monkeypatch.setenv("TORCHINDUCTOR_CACHE_DIR", str(tmp_path))
+    monkeypatch.setattr(inductor_config.cpp, "cxx", (None, "/bin/false"))
+    torch._dynamo.reset()
+
+    def f(x):
+        return (x * 3).cos() - 2
+
+    g = maybe_compile(f)
+    x = torch.arange(4.0)
+    assert torch.equal(g(x), f(x)) and torch.equal(g(x), f(x))
+    assert "torch.compile failed" in capsys.readouterr().err
+    torch._dynamo.reset()

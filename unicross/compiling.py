@@ -41,19 +41,31 @@ def maybe_compile(fn: Callable) -> Callable:
     cfg = torch._dynamo.config
     cfg.recompile_limit = max(cfg.recompile_limit, RECOMPILE_LIMIT)
     compiled = torch.compile(fn, fullgraph=True, dynamic=False)
+    impl = [compiled]
 
     @functools.wraps(fn)
-    def first_call(*args, **kwargs):
+    def call(*args, **kwargs):
         global _ANNOUNCED
-        if _ANNOUNCED:
-            return compiled(*args, **kwargs)
-        _ANNOUNCED = True
-        print(f"[unicross] compiling the step math with torch.compile (pid {os.getpid()}; about a minute "
-              "the first time, seconds from the cache; UNICROSS_COMPILE=0 runs it eagerly)", file=sys.stderr, flush=True)
+        announce = not _ANNOUNCED and impl[0] is compiled
+        if announce:
+            _ANNOUNCED = True
+            print(f"[unicross] compiling the step math with torch.compile (pid {os.getpid()}; about a minute "
+                  "the first time, seconds from the cache; UNICROSS_COMPILE=0 runs it eagerly)",
+                  file=sys.stderr, flush=True)
         t = time.perf_counter()
-        out = compiled(*args, **kwargs)
-        print(f"[unicross] step math compiled in {time.perf_counter() - t:.1f} s (pid {os.getpid()})",
-              file=sys.stderr, flush=True)
+        try:
+            out = impl[0](*args, **kwargs)
+        except torch._dynamo.exc.BackendCompilerFailed as e:  # e.g. no working C++ compiler
+            if impl[0] is not compiled:
+                raise
+            impl[0] = fn
+            print(f"[unicross] torch.compile failed ({str(e).strip().splitlines()[0][:200]}); running the step "
+                  "math eagerly (install a C++ compiler, e.g. g++, or set UNICROSS_COMPILE=0 to skip the attempt)",
+                  file=sys.stderr, flush=True)
+            return fn(*args, **kwargs)
+        if announce:
+            print(f"[unicross] step math compiled in {time.perf_counter() - t:.1f} s (pid {os.getpid()})",
+                  file=sys.stderr, flush=True)
         return out
 
-    return first_call
+    return call
