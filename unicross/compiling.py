@@ -33,7 +33,8 @@ def maybe_compile(fn: Callable) -> Callable:
     Compilation is lazy (at the first call) and specialised to the shapes and the task's
     configuration: one graph per task class, configuration and hand in a process, loaded from the
     on-disk cache when an earlier process compiled it. The first compile in a process says so on
-    stderr with its duration."""
+    stderr with its duration. If the backend fails (e.g. no working C++ compiler), the function
+    says so once and runs eagerly from then on."""
     if not compile_enabled():
         return fn
     # an evaluation process can meet more graphs than Dynamo's default of 8 (every skill, chains,
