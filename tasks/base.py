@@ -706,7 +706,9 @@ class UniCrossEnv(BaseEnv):
         if ab["no_distance"]:
             obs_vec = torch.zeros_like(obs_vec)
         goal = F.goal_features(self.mode, self.axis, cur, self.targets, zero_target=ab["no_target_obs"])
-        self._obs_parts = dict(qpos=m["qpos"], contact=obs_contact, force=obs_force, vec=obs_vec, goal=goal)
+        # measurements as observed (ablations applied) and as measured (recordings, renders)
+        self._obs_parts = dict(qpos=m["qpos"], contact=obs_contact, force=obs_force, distance=obs_vec, goal=goal)
+        self._measured = dict(qpos=m["qpos"], contact=contact, force=force_c, vec=m["link_vec"])
         info = dict(success=success, fail=drop, drop=drop, ever_dropped=self.ever_dropped.clone(),
                     lifted=lifted, relocate_pos_err=pos_err, relocate_rot_err=rot_err,
                     rotation=self.rot_acc.clone(), translation=self.trans_acc.clone(),
@@ -721,7 +723,7 @@ class UniCrossEnv(BaseEnv):
     def _get_obs_extra(self, info: dict):
         p = self._obs_parts
         hand = torch.cat([p["qpos"] + self.obs_noise, self.command], dim=-1)
-        return dict(hand=hand, object=dict(contact=p["contact"], force=p["force"], distance=p["vec"]), goal=p["goal"])
+        return dict(hand=hand, object=dict(contact=p["contact"], force=p["force"], distance=p["distance"]), goal=p["goal"])
 
     # ------------------------------------------------------------------ reward
     def compute_dense_reward(self, obs: Any, action: torch.Tensor, info: dict):

@@ -61,8 +61,10 @@ def _compare(task, kw, grasp_file):
             v, got = v.data, got.data
         if torch.is_tensor(v) and got is not saved.get(k):
             torch.testing.assert_close(got, v, atol=1e-5, rtol=1e-5, msg=lambda m: f"{task} {k}: {m}")
-    for k in ("vec", "force", "qpos", "contact", "goal"):
+    for k in ("distance", "force", "qpos", "contact", "goal"):
         torch.testing.assert_close(u._obs_parts[k], eager_state["_obs_parts"][k], atol=1e-5, rtol=1e-5)
+    for k in ("vec", "force", "qpos", "contact"):
+        torch.testing.assert_close(u._measured[k], eager_state["_measured"][k], atol=1e-5, rtol=1e-5)
     env.close()
 
 

@@ -44,7 +44,7 @@ class TrajectoryRecorder:
     def record(self, label: str = "") -> None:
         u, e = self.u, self.e
         pos, quat = u.sensor.poses()
-        parts = u._obs_parts
+        parts = u._measured  # true contacts and distances, whatever the observation ablates
         vec_h = parts["vec"][e]  # link -> surface, hand frame
         hand_q = quat[e, 0]
         probe_w = pos[e, 1:-1] + quat_apply(quat[e, 1:-1], u.link_probe)
