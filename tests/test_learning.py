@@ -146,3 +146,18 @@ def test_shipped_grasp_expert_lifts_a_held_out_object():
     obj = get_object_set("test-wrappable", limit=1)[:1]
     trials = E.run_protocol("grasp", policy, obj, trials_per_object=3, seed=0, progress=False)
     assert sum(t["success"] for t in trials) >= 2
+
+
+def test_shipped_relocate_expert_relocates_a_held_out_object():
+    """The shipped relocate expert (allegro/relocate) carries a held test object to its goal pose
+    under the paper's relocate protocol, and refuses a protocol of another skill."""
+    import pytest
+    from unicross import evaluation as E
+    from unicross.objects import get_object_set
+    policy, desc = E.resolve_policy("allegro/relocate", "allegro")
+    assert desc["skill"] == "relocate"
+    obj = get_object_set("test-wrappable", limit=1)[:1]
+    trials = E.run_protocol("relocate", policy, obj, trials_per_object=2, seed=0, progress=False)
+    assert sum(t["success"] for t in trials) >= 1
+    with pytest.raises(ValueError):
+        E.resolve_policy("allegro/relocate", "mano")
