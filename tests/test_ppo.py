@@ -162,3 +162,21 @@ def test_set_reads_numbers_the_way_users_write_them():
     assert got == {"optim": {"lr_min": 1e-5, "lr": 3e-4}, "logging": {"eval_objects": "test"},
                    "env": {"object_limit": None}}
     assert isinstance(got["optim"]["lr_min"], float)
+
+
+def test_kl_stop_ends_the_epochs_early(tmp_path):
+    """``optim.kl_stop`` ends an update at the first minibatch whose KL passes it; unset, every
+    minibatch of every epoch runs (16 frames / minibatch 8 x 2 epochs = 4 steps)."""
+    import copy
+    full = PPOTrainer(tmp_path / "full", "grasp", overrides=TINY, progress=False)
+    full.train(max_iterations=1)
+    full.close()
+    cfg = copy.deepcopy(TINY)
+    cfg["optim"]["kl_stop"] = -1.0  # any KL passes it: one step per update
+    stop = PPOTrainer(tmp_path / "stop", "grasp", overrides=cfg, progress=False)
+    stop.train(max_iterations=1)
+    stop.close()
+    import json
+    steps = {name: json.loads((tmp_path / name / "metrics.jsonl").read_text().splitlines()[0])["minibatch_steps"]
+             for name in ("full", "stop")}
+    assert steps == {"full": 4, "stop": 1}

@@ -303,8 +303,11 @@ class PPOTrainer:
                 "explained_variance", "value_clip_fraction")
         stats = {k: 0.0 for k in keys}
         stats.update(grad_norm_actor=0.0, grad_norm_critic=0.0)
-        count = 0
+        count, stopped = 0, False
+        kl_stop = oc.get("kl_stop")
         for _ in range(oc["mini_epochs"]):
+            if stopped:
+                break
             for _ in range(n_mb):
                 mb = self.rb.sample()
                 losses = self.loss(mb)
@@ -324,11 +327,15 @@ class PPOTrainer:
                 stats["grad_norm_actor"] += float(ga)
                 stats["grad_norm_critic"] += float(gc)
                 count += 1
+                if kl_stop is not None and klv > kl_stop:  # the policy moved far enough for this batch
+                    stopped = True
+                    break
         if not fitted_first:
             self.norm.update({k: flat[k] for k in OBS_KEYS})
         out = {k: v / count for k, v in stats.items()}
         out["kl"] = out.pop("kl_approx")
         out["lr"] = self.lr
+        out["minibatch_steps"] = count
         out["value_mean"], out["value_std"] = float(vn.mean), float(vn.std())
         return out
 
