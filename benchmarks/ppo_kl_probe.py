@@ -19,7 +19,9 @@ import tempfile
 import torch
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-from unicross.rl.ppo import OBS_KEYS, PPOTrainer  # noqa: E402
+from unicross.rl.algorithm import PPO  # noqa: E402
+from unicross.rl.models import OBS_KEYS  # noqa: E402
+from unicross.rl.ppo import PPOTrainer  # noqa: E402
 
 
 def main():
@@ -29,7 +31,7 @@ def main():
     p.add_argument("--log-std", type=float, default=-3.0)
     p.add_argument("--iterations", type=int, default=4)
     args = p.parse_args()
-    update, schedule = PPOTrainer._update, PPOTrainer._schedule_lr
+    update, schedule = PPO.update, PPO._schedule_lr
 
     def probed_update(self, data):
         self._kls = []
@@ -55,7 +57,7 @@ def main():
         self._kls.append(kl)
         return schedule(self, kl)
 
-    PPOTrainer._update, PPOTrainer._schedule_lr = probed_update, probed_schedule
+    PPO.update, PPO._schedule_lr = probed_update, probed_schedule
     overrides = {"env": {"num_envs": 2, "object_limit": 1}, "logging": {"eval_trials": 0, "final_eval_trials": 0},
                  "collector": {"total_frames": 1024 * args.iterations},
                  "optim": {"lr": args.lr, "lr_min": args.lr}, "model": {"init_log_std": args.log_std}}

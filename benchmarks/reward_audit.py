@@ -12,12 +12,11 @@ import argparse
 import time
 from pathlib import Path
 
-from unicross import formulation as F
 from unicross.audit import audit, behaviours, format_rows
 from unicross.config import load_preset
+from unicross.registry import SKILLS
 
-MODES = [("grasp", None), ("relocate", None)] + [("rotate", a) for a in F.ROTATE_AXES] + \
-    [("translate", d) for d in F.TRANSLATE_DIRECTIONS]
+MODES = [(s.name, a) for s in SKILLS.values() for a in (s.axes or (None,))]
 
 
 def main(argv=None) -> int:

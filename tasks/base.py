@@ -30,6 +30,7 @@ from mani_skill.utils.structs.pose import Pose
 from mani_skill.utils.structs.types import SimConfig
 
 from unicross import formulation as F
+from unicross import registry as R
 from unicross.compiling import compile_enabled, maybe_compile
 from unicross.config import load_config
 from unicross.geometry import (
@@ -38,7 +39,7 @@ from unicross.geometry import (
 )
 from unicross.grasps import GraspSet, default_grasp_path
 from unicross.objects import resolve_objects
-from unicross.rewards import TERMS as REWARD_TERMS, RewardTerms
+from unicross.rewards import RewardTerms
 from unicross.robots.hand import HAND_FRAME_LINK, HandSpec, load_hand, register_hand_agent
 from unicross.sensing import HandObjectSensor
 
@@ -60,8 +61,6 @@ def _freeze_heap_once() -> None:
 
 
 CATEGORY_ID = {"wrappable": 0, "elongated": 1}
-MODE_CATEGORIES = {"grasp": ("wrappable", "elongated"), "relocate": ("wrappable", "elongated"),
-                   "rotate": ("wrappable",), "translate": ("elongated",)}
 
 
 def _tensors(obs):
@@ -140,10 +139,10 @@ class UniCrossEnv(BaseEnv):
         self.object_names = [o.name for o in objs]
         objs = [o.scaled(self.hand_spec.object_scale) for o in objs]
         self.object_specs = objs
-        # valid (object, mode) pairs: rotate needs wrappable, translate elongated objects
-        # valid (object, mode) pairs, interleaved round-robin over modes so that consecutive pairs
-        # (parallel envs, successive rebuilds) spread over all modes
-        per_mode = [[(oi, F.MODES.index(m)) for oi, o in enumerate(objs) if o.category in MODE_CATEGORIES[F.mode_skill(m)]]
+        # valid (object, mode) pairs (the object's category is one of its skill's, see the registry),
+        # interleaved round-robin over modes so that consecutive pairs (parallel envs, successive
+        # rebuilds) spread over all modes
+        per_mode = [[(oi, F.MODES.index(m)) for oi, o in enumerate(objs) if o.category in R.skill_of_mode(m).categories]
                     for m in modes]
         self._pairs = [lst[r] for r in range(max(map(len, per_mode), default=0)) for lst in per_mode if r < len(lst)]
         if not self._pairs:
@@ -292,8 +291,8 @@ class UniCrossEnv(BaseEnv):
         self.episode_length = torch.tensor([self.cfg["episode_length"][F.mode_skill(m)] for m in F.MODES], device=dev)
         self.rewards = RewardTerms(self.reward_cfg, dev, self.cfg["ablation"]["no_track_reward"])
         self.motion = F.MotionParams(dt=self.control_dt, **self.cfg["motion"])
-        self._speed_cap = torch.tensor([self.cfg["motion"]["omega_max"] if F.mode_skill(m) == "rotate"
-                                        else self.cfg["motion"]["v_max"] for m in F.MODES], device=dev)
+        self._speed_cap = torch.tensor([self.cfg["motion"][R.skill_of_mode(m).speed] for m in F.MODES], device=dev)
+        self._gravity = float(abs(self.sim_config.scene_config.gravity[2]))  # m/s^2 (disturbance magnitudes)
         self._world_up = torch.tensor([0.0, 0.0, 1.0], device=dev)
         rc = self.cfg["randomization"]
         wp, wr = rc["wrist_obs_noise"]
@@ -383,13 +382,13 @@ class UniCrossEnv(BaseEnv):
                 xu = torch.tensor([0.0, 0.0, 1.0], device=dev).expand(b, 3)
                 zu = torch.stack([torch.cos(psi), torch.sin(psi), torch.zeros_like(psi)], -1)
                 random_q = quat_from_matrix(torch.stack([xu, torch.cross(zu, xu, dim=-1), zu], dim=-1))
-            world_q = torch.where((skill == F.SKILLS.index("relocate"))[:, None], gs["wrist_pose"][:, 3:], random_q)
+            world_q = torch.where((skill == F.skill_id("relocate"))[:, None], gs["wrist_pose"][:, 3:], random_q)
             world_p = gs["wrist_pose"][:, :3].clone()
             inhand_h = self.cfg["in_hand_start_height"]
-            world_p = torch.where((skill == F.SKILLS.index("relocate"))[:, None], world_p,
+            world_p = torch.where((skill == F.skill_id("relocate"))[:, None], world_p,
                                   torch.tensor([0.0, 0.0, inhand_h], device=dev).expand(b, 3))
             op, oq = pose_mul(world_p, world_q, gs["object_pose_hand"][:, :3], gs["object_pose_hand"][:, 3:])
-            is_grasp = (skill == 0)[:, None]
+            is_grasp = (skill == F.skill_id("grasp"))[:, None]
             hand_p = torch.where(is_grasp, hand_p, world_p)
             hand_q = torch.where(is_grasp, hand_q, world_q)
             obj_p = torch.where(is_grasp, obj_p, op)
@@ -426,7 +425,7 @@ class UniCrossEnv(BaseEnv):
         rpy = (torch.rand(b, 3, generator=g, device=dev) * 2 - 1) * rt["rpy"]
         fp, fqw = obj_p + off, quat_positive(quat_mul(quat_from_euler_xyz(rpy), obj_q))
         fx, fqr = relative_pose(hand_p, hand_q, fp, fqw)
-        is_reloc = (skill == F.SKILLS.index("relocate"))[:, None]
+        is_reloc = (skill == F.skill_id("relocate"))[:, None]
         self.final_x_or[env_idx] = torch.where(is_reloc, fx, xo)
         self.final_q_or[env_idx] = torch.where(is_reloc, fqr, qo)
         cmd = torch.zeros(b, spec.dof, device=dev)
@@ -443,7 +442,7 @@ class UniCrossEnv(BaseEnv):
         dmax = self.cfg["disturbance"]["max_scale"]
         if dmax > 0:  # constant force: random direction, magnitude U[0, dmax * m * g]
             direction = torch.nn.functional.normalize(torch.randn(b, 3, generator=g, device=dev), dim=-1)
-            mag = torch.rand(b, generator=g, device=dev) * dmax * self.obj_mass[env_idx] * 9.81
+            mag = torch.rand(b, generator=g, device=dev) * dmax * self.obj_mass[env_idx] * self._gravity
             self.disturb[env_idx] = direction * mag[:, None]
         self.obs_noise[env_idx] = self._draw_obs_noise(b)
         for t in (self.obj_vel_h, self.obj_angvel_h, self.hand_vel, self.hand_angvel):
@@ -543,7 +542,7 @@ class UniCrossEnv(BaseEnv):
         lift_after = self.cfg["grasp"]["lift_after"]
         if lift_after is None or self.static_skill not in (None, "grasp"):
             return torch.zeros_like(self.lift)
-        lifting = (self.mode == 0) & (elapsed_steps >= lift_after)
+        lifting = (self.mode == F.mode_index("grasp")) & (elapsed_steps >= lift_after)
         up_root = quat_apply(quat_inv(self.root_q), self._world_up.expand_as(self.lift))
         step = lifting[:, None].float() * up_root * self.cfg["grasp"]["lift_speed"] * self.control_dt
         self.lift = self.lift + step
@@ -644,8 +643,8 @@ class UniCrossEnv(BaseEnv):
         self.hand_vel = torch.where(p1, hv, self.hand_vel)
         self.hand_angvel = torch.where(p1, hw, self.hand_angvel)
         skill = F.MODE_SKILL_ID.to(self.device)[self.mode]
-        is_rot = skill == F.SKILLS.index("rotate")
-        is_trans = skill == F.SKILLS.index("translate")
+        is_rot = skill == F.skill_id("rotate")
+        is_trans = skill == F.skill_id("translate")
         axis_prev = self.axis
         self.rot_acc = self.rot_acc + (pend & is_rot).float() * (w * axis_prev).sum(-1) * dt
         self.trans_acc = self.trans_acc + (pend & is_trans).float() * (v * axis_prev).sum(-1) * dt
@@ -657,7 +656,7 @@ class UniCrossEnv(BaseEnv):
         # a grasp can only drop what it lifted: before the lift phase the object rests on the table
         lift_after = self.cfg["grasp"]["lift_after"]
         grasp_lifting = (elapsed_steps >= lift_after) if lift_after is not None else torch.zeros_like(drop)
-        drop = drop & ((skill != 0) | grasp_lifting)
+        drop = drop & ((skill != F.skill_id("grasp")) | grasp_lifting)
         self.ever_dropped = self.ever_dropped | drop
         # advance the targets; after a drop they hold still: a lost object's pose no longer defines
         # where the hand should go (Tracked hand targets would chase it; measured: the wrist
@@ -727,7 +726,7 @@ class UniCrossEnv(BaseEnv):
 
     # ------------------------------------------------------------------ reward
     def compute_dense_reward(self, obs: Any, action: torch.Tensor, info: dict):
-        return sum(info[f"reward_{k}"] for k in REWARD_TERMS)
+        return sum(info[f"reward_{k}"] for k in self.rewards.names)
 
     def compute_normalized_dense_reward(self, obs: Any, action: torch.Tensor, info: dict):
         return self.compute_dense_reward(obs, action, info)

@@ -22,9 +22,10 @@ from mani_skill.utils.structs.pose import Pose
 from unicross import formulation as F
 from unicross.geometry import quat_apply, quat_from_euler_xyz, quat_inv, quat_mul, quat_positive, relative_pose
 from unicross.objects import get_object_set, resolve_objects
-from unicross.tasks.base import MODE_CATEGORIES, UniCrossEnv
+from unicross.registry import SKILLS, skill_of_mode
+from unicross.tasks.base import UniCrossEnv
 
-PHASE_STEPS = dict(grasp=75, relocate=75, rotate=400, translate=50)  # the evaluation protocols' lengths
+PHASE_STEPS = {s.name: s.protocol_steps for s in SKILLS.values()}  # the evaluation protocols' lengths
 
 
 def parse_sequence(seq: str | Sequence[str]) -> List[str]:
@@ -54,9 +55,7 @@ class ChainEnv(UniCrossEnv):
         steps = dict(PHASE_STEPS, **(phase_steps or {}))
         self.phase_lengths = [steps[F.mode_skill(m)] for m in self.sequence]
         self.phase_ends = torch.cumsum(torch.tensor(self.phase_lengths), 0).tolist()
-        cats = set(MODE_CATEGORIES["grasp"])
-        for m in self.sequence:
-            cats &= set(MODE_CATEGORIES[F.mode_skill(m)])
+        cats = set.intersection(*(set(skill_of_mode(m).categories) for m in self.sequence))
         self._chain_categories = cats
         cfg = dict(kwargs.pop("config", None) or {})
         cfg.setdefault("episode_length", {})["grasp"] = self.phase_ends[-1]
@@ -82,7 +81,7 @@ class ChainEnv(UniCrossEnv):
         obs, reward, terminated, truncated, info = super().step(action)
         skill = F.mode_skill(self.sequence[self.phase])
         at_end = int(self.elapsed_steps[0]) >= self.phase_ends[self.phase]
-        if skill in ("rotate", "translate"):  # "exceeded within the phase"
+        if SKILLS[skill].success_once:  # "exceeded within the phase"
             self.phase_success[:, self.phase] |= info["success"]
         elif at_end:
             self.phase_success[:, self.phase] = info["success"]

@@ -1,52 +1,52 @@
-"""The UniCross task ids. Skills differ only by data: their modes and default object sets."""
+"""The UniCross task ids. Skills differ only by data (:mod:`unicross.registry`): their modes and
+default object sets."""
 from __future__ import annotations
 
 from unicross.tasks.registration import register_task
 
-from unicross import formulation as F
+from unicross.config import load_config
+from unicross.registry import SKILLS
 from unicross.tasks.base import UniCrossEnv
 
-EPISODE_STEPS = dict(grasp=64, relocate=64, rotate=400, translate=64)  # configs/task.yaml episode_length
+EPISODE_STEPS = load_config("task")["episode_length"]  # the TimeLimit of each id; the task truncates by its config
 
 
-@register_task("UniCross-Grasp-v1", max_episode_steps=EPISODE_STEPS["grasp"])
+@register_task(SKILLS["grasp"].env_id, max_episode_steps=EPISODE_STEPS["grasp"])
 class GraspEnv(UniCrossEnv):
     """Grasp an object resting on the table from a top-down start (see :class:`UniCrossEnv`)."""
 
-    DEFAULT_OBJECTS = "train"
-    DEFAULT_MODES = ("grasp",)
+    DEFAULT_OBJECTS = SKILLS["grasp"].train_objects
+    DEFAULT_MODES = SKILLS["grasp"].modes
 
     def __init__(self, *args, **kwargs):
         super().__init__(*args, modes=self.DEFAULT_MODES, **kwargs)
 
 
-@register_task("UniCross-Relocate-v1", max_episode_steps=EPISODE_STEPS["relocate"])
+@register_task(SKILLS["relocate"].env_id, max_episode_steps=EPISODE_STEPS["relocate"])
 class RelocateEnv(GraspEnv):
     """Move a grasped object to a final pose with the object fixed in the hand."""
 
-    DEFAULT_MODES = ("relocate",)
+    DEFAULT_MODES = SKILLS["relocate"].modes
 
 
-@register_task("UniCross-Rotate-v1", max_episode_steps=EPISODE_STEPS["rotate"])
+@register_task(SKILLS["rotate"].env_id, max_episode_steps=EPISODE_STEPS["rotate"])
 class RotateEnv(UniCrossEnv):
     """Rotate a grasped wrappable object in hand about ``axis`` of the hand frame."""
 
-    DEFAULT_OBJECTS = "train-wrappable"
+    DEFAULT_OBJECTS = SKILLS["rotate"].train_objects
 
     def __init__(self, *args, axis: str = "z+", **kwargs):
-        F.mode_index("rotate", axis)  # validates
-        super().__init__(*args, modes=(f"rotate_{axis}",), **kwargs)
+        super().__init__(*args, modes=(SKILLS["rotate"].mode(axis),), **kwargs)
 
 
-@register_task("UniCross-Translate-v1", max_episode_steps=EPISODE_STEPS["translate"])
+@register_task(SKILLS["translate"].env_id, max_episode_steps=EPISODE_STEPS["translate"])
 class TranslateEnv(UniCrossEnv):
     """Translate a grasped elongated object in hand along ``direction`` (hand-frame z)."""
 
-    DEFAULT_OBJECTS = "train-elongated"
+    DEFAULT_OBJECTS = SKILLS["translate"].train_objects
 
     def __init__(self, *args, direction: str = "z+", **kwargs):
-        F.mode_index("translate", direction)  # validates
-        super().__init__(*args, modes=(f"translate_{direction}",), **kwargs)
+        super().__init__(*args, modes=(SKILLS["translate"].mode(direction),), **kwargs)
 
 
 @register_task("UniCross-MultiSkill-v1", max_episode_steps=max(EPISODE_STEPS.values()))

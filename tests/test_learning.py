@@ -63,7 +63,7 @@ def test_nonfinite_step_is_zeroed_reported_and_ends_the_episode():
     env = gym.make("UniCross-Grasp-v1", **ENV)
     u = env.unwrapped
     u.reset(seed=0)
-    u.rewards.reg["w_vel"] = float("nan")
+    u.rewards.coefficients("wrist_velocity")["w_vel"] = float("nan")
     obs, r, term, trunc, info = u.step(torch.zeros(1, u.hand_spec.dof))
     assert bool(info["nonfinite"][0]) and bool(trunc[0]) and float(r[0]) == 0.0
     env.close()

@@ -39,7 +39,7 @@ import torch
 from unicross import formulation as F
 from unicross.config import load_config
 
-from unicross.rewards import TERMS
+from unicross.rewards import term_names
 
 
 # ----------------------------------------------------------------------------- reference behaviours
@@ -101,7 +101,7 @@ def _oracle(u):
     from mani_skill.utils.structs.pose import Pose
     from unicross.geometry import pose_mul, quat_from_axis_angle, quat_mul, quat_positive
     axis = F.MODE_AXES.to(u.device)[u.mode]
-    rotate = F.mode_skill(F.MODES[int(u.mode[0])]) == "rotate"
+    rotate = F.mode_skill(F.MODES[int(u.mode[0])]) == "rotate"  # the oracle turns or slides
     step_angle = u.cfg["motion"]["omega_max"] * u.control_dt
     step_dist = u.cfg["motion"]["v_max"] * u.control_dt
     held = dict(x=u.cur_rel.x_oh.clone(), q=u.cur_rel.q_oh.clone())
@@ -161,25 +161,25 @@ def audit(skill: str = "grasp", axis: Optional[str] = None, objects: Optional[st
     import unicross  # noqa: F401  (registers the tasks)
     from tqdm import tqdm
     from unicross.objects import get_object_set
-    from unicross.rl.ppo import SKILL_ENV, env_kwargs_for
+    from unicross.registry import skill as skill_entry
+    from unicross.rl.ppo import env_kwargs_for
     cfg = load_config("ppo", ppo_overrides)
     gamma, scale = cfg["gae"]["gamma"], cfg["gae"]["reward_scale"]
     kw = env_kwargs_for(skill, axis, hand, cfg["env"])
     kw.pop("object_limit", None)
     kw.pop("reconfiguration_freq", None)
-    default_set = {"grasp": "train", "relocate": "train", "rotate": "train-wrappable",
-                   "translate": "train-elongated"}[skill]
-    objs = get_object_set(objects or default_set, limit=limit)
+    objs = get_object_set(objects or skill_entry(skill).train_objects, limit=limit)
     beh = behaviours(skill)
     if only:
         bad = [b for b in only if b not in beh]
         if bad:
             raise ValueError(f"unknown behaviour(s) {bad}; valid for {skill}: {list(beh)}")
         beh = {k: v for k, v in beh.items() if k in only}
-    acc = {b: dict(total=[], raw=[], succeeded=[], terms={t: [] for t in TERMS}) for b in beh}
+    terms = term_names()
+    acc = {b: dict(total=[], raw=[], succeeded=[], terms={t: [] for t in terms}) for b in beh}
     bar = tqdm(total=len(objs) * seeds * len(beh), desc=f"audit {skill}", disable=not progress)
     for oi, obj in enumerate(objs):
-        env = gym.make(SKILL_ENV[skill], obs_mode="state_dict", sim_backend="physx_cpu", render_backend="none",
+        env = gym.make(skill_entry(skill).env_id, obs_mode="state_dict", sim_backend="physx_cpu", render_backend="none",
                        num_envs=1, **{**kw, "objects": [obj]})
         u = env.unwrapped
         length = int(u.episode_length[u.mode[0]])
@@ -188,11 +188,11 @@ def audit(skill: str = "grasp", axis: Optional[str] = None, objects: Optional[st
                 u.reset(seed=10_007 * oi + k)
                 act = make(u)
                 disc = 1.0
-                ret = {t: 0.0 for t in TERMS}
+                ret = {t: 0.0 for t in terms}
                 raw, success = 0.0, False
                 for _ in range(length):
                     _, r, term, trunc, info = u.step(act())
-                    for t in TERMS:
+                    for t in terms:
                         ret[t] += disc * scale * float(info[f"reward_{t}"][0])
                     raw += float(r[0])
                     disc *= gamma
@@ -200,7 +200,7 @@ def audit(skill: str = "grasp", axis: Optional[str] = None, objects: Optional[st
                     if bool(term[0]) or bool(trunc[0]):
                         break
                 u.__dict__.pop("_after_control_step", None)  # the oracle's hook, if any
-                for t in TERMS:
+                for t in terms:
                     acc[name]["terms"][t].append(ret[t])
                 acc[name]["total"].append(sum(ret.values()))
                 acc[name]["raw"].append(raw)
@@ -209,16 +209,17 @@ def audit(skill: str = "grasp", axis: Optional[str] = None, objects: Optional[st
         env.close()
     bar.close()
     mean = lambda xs: sum(xs) / max(len(xs), 1)
-    rows = [AuditRow(b, len(a["total"]), mean(a["succeeded"]), mean(a["total"]), {t: mean(a["terms"][t]) for t in TERMS},
+    rows = [AuditRow(b, len(a["total"]), mean(a["succeeded"]), mean(a["total"]), {t: mean(a["terms"][t]) for t in terms},
                      mean(a["raw"]), min(a["total"])) for b, a in acc.items()]
     return sorted(rows, key=lambda r: -r.total)
 
 
 def format_rows(rows: List[AuditRow]) -> str:
+    terms = list(rows[0].terms) if rows else list(term_names())
     head = "| rank | behaviour | n | success | return (disc., scaled) | worst | raw return | " + \
-           " | ".join(TERMS) + " |"
-    lines = [head, "|" + "---|" * (7 + len(TERMS))]
+           " | ".join(terms) + " |"
+    lines = [head, "|" + "---|" * (7 + len(terms))]
     for i, r in enumerate(rows, 1):
         lines.append(f"| {i} | {r.behaviour} | {r.episodes} | {100 * r.success:.0f}% | {r.total:.3f} | "
-                     f"{r.min_total:.3f} | {r.undiscounted:.1f} | " + " | ".join(f"{r.terms[t]:.3f}" for t in TERMS) + " |")
+                     f"{r.min_total:.3f} | {r.undiscounted:.1f} | " + " | ".join(f"{r.terms[t]:.3f}" for t in terms) + " |")
     return "\n".join(lines)

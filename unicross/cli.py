@@ -339,6 +339,9 @@ def _cmd_chain(args) -> int:
 
 
 def main(argv=None) -> int:
+    from unicross.config import load_config
+    from unicross.registry import SKILLS
+    axes_help = "; ".join(f"{s.name}: {','.join(s.axes)}" for s in SKILLS.values() if s.axes)
     p = argparse.ArgumentParser(prog="unicross", description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = p.add_subparsers(dest="cmd", required=True)
     s = sub.add_parser("info", help="print task ids, sizes and the target table")
@@ -379,7 +382,8 @@ def main(argv=None) -> int:
     s.add_argument("--protocol", default="all", help="grasp, relocate, rotate, translate (comma list) or all")
     s.add_argument("--objects", default="test", help="object set: train | test | unseen (| -wrappable/-elongated | mesh:<file>)")
     s.add_argument("--limit", type=int, default=None, help="first N objects per (category, type) group")
-    s.add_argument("--trials-per-object", type=int, default=25)
+    s.add_argument("--trials-per-object", type=int, default=load_config("eval")["trials_per_object"],
+                   help="starts per object and axis (default: configs/eval.yaml, the paper's 25)")
     s.add_argument("--disturb", action="store_true", help="constant random force U[0, 10 m g] on the object")
     s.add_argument("--original", action="store_true",
                    help="baselines' original settings: no table (grasp), palm up and fixed wrist (rotate/translate)")
@@ -435,8 +439,8 @@ def main(argv=None) -> int:
     s.add_argument("--eval", action="append", help="an eval JSON written by `unicross eval` to record")
     s.set_defaults(fn=_cmd_export)
     s = sub.add_parser("audit", help="reward audit: discounted, scaled returns of reference behaviours, ranked")
-    s.add_argument("--skill", choices=["grasp", "relocate", "rotate", "translate"], default="grasp")
-    s.add_argument("--axis", default=None, help="rotate: x+,x-,y+,y-,z+,z-; translate: z+,z-")
+    s.add_argument("--skill", choices=list(SKILLS), default="grasp")
+    s.add_argument("--axis", default=None, help=axes_help)
     s.add_argument("--objects", default=None, help="object set (default: the skill's training set)")
     s.add_argument("--limit", type=int, default=2, help="first N objects per (category, type) group")
     s.add_argument("--seeds", type=int, default=3, help="episodes per object and behaviour")
@@ -449,8 +453,8 @@ def main(argv=None) -> int:
     s = sub.add_parser("train", help="train one expert with PPO (TorchRL); resumable")
     s.add_argument("--preset", action="append", metavar="NAME",
                    help="configs/presets/NAME.yaml: paper_gpu (the paper's PPO values), paper_reward (its exact reward)")
-    s.add_argument("--skill", choices=["grasp", "relocate", "rotate", "translate"], default=None)
-    s.add_argument("--axis", default=None, help="rotate: x+,x-,y+,y-,z+,z-; translate: z+,z-")
+    s.add_argument("--skill", choices=list(SKILLS), default=None)
+    s.add_argument("--axis", default=None, help=axes_help)
     s.add_argument("--direction", dest="axis", help=argparse.SUPPRESS)
     s.add_argument("--hand", default="allegro")
     s.add_argument("--out", required=True, help="run directory (checkpoint, metrics.csv, metrics.jsonl, tb/)")

@@ -17,6 +17,9 @@ hand frame and in the world, drop flags) and scores it with :mod:`unicross.metri
   --disturb  adds a constant force of random direction and magnitude U[0, 10 m g] on the object
              for the whole episode (grasp: while lifting)
 
+The protocol settings (trials per object, disturbance scale, PE/AE window) are in
+``configs/eval.yaml``; steps, axes and object categories per protocol in :mod:`unicross.registry`.
+
 Policies: a checkpoint path, ``zero`` (no action), ``random`` or ``scripted-relocate`` (the
 paper's naive relocation baseline). Same seed and policy give identical results.
 """
@@ -31,20 +34,22 @@ from tqdm import tqdm
 
 from unicross import formulation as F
 from unicross import metrics as M
+from unicross import registry as R
+from unicross.config import load_config
 from unicross.geometry import pose_inv, pose_mul, quat_to_euler_xyz
 from unicross.objects import ObjectSpec
 
 logger = logging.getLogger(__name__)
 
-PROTOCOLS = ("grasp", "relocate", "rotate", "translate")
-STEPS = dict(grasp=75, relocate=75, rotate=400, translate=50)
-AXES = dict(grasp=[None], relocate=[None], rotate=list(F.ROTATE_AXES), translate=list(F.TRANSLATE_DIRECTIONS))
-ENV_ID = dict(grasp="UniCross-Grasp-v1", relocate="UniCross-Relocate-v1", rotate="UniCross-Rotate-v1",
-              translate="UniCross-Translate-v1")
-CATEGORY = dict(grasp=None, relocate=None, rotate="wrappable", translate="elongated")
+EVAL_CFG = load_config("eval")  # protocol settings (configs/eval.yaml)
+PROTOCOLS = R.SKILL_NAMES  # one protocol per skill (its steps, axes, env and objects: unicross.registry)
 
 PolicyFn = Callable[[dict, object], torch.Tensor]
-SHORT_NAMES = dict(grasp="Gr.", relocate="Re.", rotate="Rot.", translate="Trans.")
+
+
+def _axes(protocol: str) -> List[Optional[str]]:
+    """The axes a protocol runs (``[None]`` for a skill without axes)."""
+    return list(R.skill(protocol).axes) or [None]
 
 
 # ----------------------------------------------------------------------------- policies
@@ -133,28 +138,25 @@ def resolve_policy(spec: str, hand: str, seed: int = 0):
 # ----------------------------------------------------------------------------- one protocol
 def _env_for(protocol: str, axis: Optional[str], obj: ObjectSpec, hand: str, disturb: bool, randomize: bool,
              grasp_dataset, original: bool, ablation: Optional[dict] = None):
-    cfg = dict(episode_length={protocol: STEPS[protocol]})
+    sk = R.skill(protocol)
+    cfg = dict(episode_length={protocol: sk.protocol_steps})
     if ablation:  # a policy trained without some inputs is evaluated with the same switches
         cfg["ablation"] = dict(ablation)
     if disturb:
-        cfg["disturbance"] = dict(max_scale=10.0)
+        cfg["disturbance"] = dict(max_scale=EVAL_CFG["disturbance_scale"])
     if original and protocol == "grasp":
         cfg["table"] = False  # GraspXL's setting: no table
-    if original and protocol in ("rotate", "translate"):
+    if original and sk.axes:
         cfg["in_hand_orientation"] = "palm_up"  # RotateIt / in-hand translation: palm up, wrist fixed
     kw = dict(obs_mode="state_dict", sim_backend="physx_cpu", render_backend="none", hand=hand, objects=[obj],
-              randomize=randomize, config=cfg)
-    if protocol == "rotate":
-        kw["axis"] = axis
-    if protocol == "translate":
-        kw["direction"] = axis
+              randomize=randomize, config=cfg, **sk.env_kwargs(axis))
     if protocol != "grasp" and grasp_dataset is not None:
         kw["grasp_dataset"] = grasp_dataset
-    return gym.make(ENV_ID[protocol], **kw)
+    return gym.make(sk.env_id, **kw)
 
 
 def run_protocol(protocol: str, policy: PolicyFn, objects: Sequence[ObjectSpec], hand: str = "allegro",
-                 trials_per_object: int = 25, seed: int = 0, disturb: bool = False, randomize: bool = False,
+                 trials_per_object: int = EVAL_CFG["trials_per_object"], seed: int = 0, disturb: bool = False, randomize: bool = False,
                  grasp_dataset=None, original: bool = False, progress: bool = True,
                  videos: int = 0, video_dir=None, ablation: Optional[dict] = None,
                  axes: Optional[Sequence[str]] = None, shard: Optional[Tuple[int, int]] = None) -> List[dict]:
@@ -165,14 +167,15 @@ def run_protocol(protocol: str, policy: PolicyFn, objects: Sequence[ObjectSpec],
     list, so n shards together give exactly the trials of one unsharded run."""
     if protocol not in PROTOCOLS:
         raise ValueError(f"unknown protocol {protocol!r}; valid: {list(PROTOCOLS)}")
-    bad = [a for a in (axes or []) if a not in AXES[protocol]]
+    sk = R.skill(protocol)
+    all_axes = _axes(protocol)
+    bad = [a for a in (axes or []) if a not in all_axes]
     if bad:
-        raise ValueError(f"axes {bad} are not axes of protocol {protocol!r}: {AXES[protocol]}")
-    axes = list(axes) if axes else AXES[protocol]
-    cat = CATEGORY[protocol]
-    objs = [o for o in objects if cat is None or o.category == cat]
+        raise ValueError(f"axes {bad} are not axes of protocol {protocol!r}: {all_axes}")
+    axes = list(axes) if axes else all_axes
+    objs = [o for o in objects if o.category in sk.categories]
     if not objs:
-        raise ValueError(f"no {cat} object in the set for protocol {protocol!r}")
+        raise ValueError(f"no {' or '.join(sk.categories)} object in the set for protocol {protocol!r}")
     if protocol != "grasp":  # in-hand protocols start from grasps: objects without one cannot be evaluated
         from unicross.grasps import GraspSet, default_grasp_path
         gs = grasp_dataset if isinstance(grasp_dataset, GraspSet) else \
@@ -186,7 +189,7 @@ def run_protocol(protocol: str, policy: PolicyFn, objects: Sequence[ObjectSpec],
         if lacking:
             logger.warning(f"{protocol}: {len(lacking)} object(s) without a grasp are not evaluated: {lacking}")
             objs = [o for o in objs if o.name in have]
-    steps = STEPS[protocol]
+    steps = sk.protocol_steps
     trials = []
     mine = [oi for oi in range(len(objs)) if shard is None or oi % shard[1] == shard[0]]
     total = len(mine) * len(axes) * trials_per_object
@@ -196,20 +199,20 @@ def run_protocol(protocol: str, policy: PolicyFn, objects: Sequence[ObjectSpec],
         for axis in axes:
             env = _env_for(protocol, axis, obj, hand, disturb, randomize, grasp_dataset, original, ablation)
             u = env.unwrapped
-            axis_vec = F.MODE_AXES[F.mode_index(protocol, axis) if protocol in ("rotate", "translate") else 0]
+            axis_vec = F.MODE_AXES[F.mode_index(protocol, axis)]
             for k in range(trials_per_object):
-                trial_seed = seed * 1_000_003 + oi * 10_007 + (AXES[protocol].index(axis)) * 1009 + k
+                trial_seed = seed * 1_000_003 + oi * 10_007 + all_axes.index(axis) * 1009 + k
                 obs, info = u.reset(seed=trial_seed)
                 rec = None
                 if len(trials) < videos:
                     from unicross.trajectory import TrajectoryRecorder
-                    rec = TrajectoryRecorder(u, task_id=ENV_ID[protocol])
+                    rec = TrajectoryRecorder(u, task_id=sk.env_id)
                     rec.record(protocol)
                 x_oh, q_oh, p_w, q_w, drop = [u.cur_rel.x_oh.clone()], [u.cur_rel.q_oh.clone()], [], [], []
                 goal_p, goal_q = pose_mul(u.root_p, u.root_q, u.final_x_or, u.final_q_or)
                 for t in range(steps):
                     a = policy(obs, u)
-                    if original and protocol in ("rotate", "translate"):
+                    if original and sk.axes:
                         a[:, :6] = 0.0  # fixed wrist
                     obs, _, term, _, info = u.step(a)
                     x_oh.append(u.cur_rel.x_oh.clone())
@@ -237,7 +240,7 @@ def merge_shards(protocol: str, objects: Sequence[ObjectSpec], parts: Sequence[L
     """The trials of shards of one :func:`run_protocol` call, in the order one unsharded call gives."""
     order = {o.name: i for i, o in enumerate(objects)}
     return sorted((t for part in parts for t in part),
-                  key=lambda t: (order[t["object"]], AXES[protocol].index(t["axis"]) if t["axis"] else 0, t["trial"]))
+                  key=lambda t: (order[t["object"]], _axes(protocol).index(t["axis"]), t["trial"]))
 
 
 def _protocol_shard(spec: str, hand: str, policy_seed: int, protocol: str, objects, kwargs: dict, shard) -> List[dict]:
@@ -286,7 +289,7 @@ def _score(protocol, obj, axis, k, seed, axis_vec, x_oh, q_oh, p_w, q_w, drop, g
         lifted = bool(((p_w[:, -1, 2] - u.obj_z0) > u.cfg["grasp"]["lift_success"])[0])
         row.update(lifted=lifted, success=lifted and not dropped)
     elif protocol == "relocate":
-        pe, ae = M.pose_errors(p_w, q_w, goal_p, goal_q, window=25)
+        pe, ae = M.pose_errors(p_w, q_w, goal_p, goal_q, window=EVAL_CFG["pose_error_window"])
         pe_end, ae_end = M.pose_errors(p_w, q_w, goal_p, goal_q, window=1)
         sc = u.cfg["success"]
         ok = bool(pe_end[0] < sc["relocate_pos"]) and bool(ae_end[0] < sc["relocate_rot"])
@@ -342,7 +345,7 @@ def markdown_table(rows: Dict[str, Dict[str, dict]]) -> str:
 
 # ----------------------------------------------------------------------------- long horizon
 def run_chain(policy: PolicyFn, objects: Sequence[ObjectSpec], sequence: Optional[str] = None,
-              hand: str = "allegro", trials_per_object: int = 25, seed: int = 0, randomize: bool = False,
+              hand: str = "allegro", trials_per_object: int = EVAL_CFG["trials_per_object"], seed: int = 0, randomize: bool = False,
               progress: bool = True, videos: int = 0, video_dir=None) -> List[dict]:
     """Long-horizon protocol: grasp -> relocate -> in-hand from random table poses in one episode.
 
@@ -355,8 +358,8 @@ def run_chain(policy: PolicyFn, objects: Sequence[ObjectSpec], sequence: Optiona
     for oi, obj in enumerate(objects):
         for k in range(trials_per_object):
             if sequence is None:
-                axes = F.ROTATE_AXES if obj.category == "wrappable" else F.TRANSLATE_DIRECTIONS
                 skill = "rotate" if obj.category == "wrappable" else "translate"
+                axes = R.skill(skill).axes
                 seq = f"grasp,relocate,{skill}:{axes[int(torch.randint(len(axes), (1,), generator=rng))]}"
             else:
                 seq = sequence
@@ -395,7 +398,7 @@ def summarize_chain(trials: List[dict]) -> Dict[str, dict]:
     """Per sequence kind (Gr.+Re.+Rot. / Gr.+Re.+Trans.): per-phase and overall SR."""
     groups: Dict[str, List[dict]] = {}
     for t in trials:
-        kind = " + ".join(SHORT_NAMES[F.mode_skill(m)] for m in t["sequence"])
+        kind = " + ".join(R.skill_of_mode(m).short_name for m in t["sequence"])
         groups.setdefault(kind, []).append(t)
     out = {}
     for kind, ts in groups.items():

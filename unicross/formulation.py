@@ -8,8 +8,8 @@ Relational poses (``SLOTS``)
     x_hr, q_hr  hand in the root frame
 Targets
     each slot's target is Tracked (updated every step by a named rule), Fixed (value at the
-    episode start) or Free (the current value, i.e. unconstrained). ``SKILL_TARGETS`` below is
-    the paper's Table 1 as data; the ten modes are instantiations of the four skills.
+    episode start) or Free (the current value, i.e. unconstrained). ``SKILL_TARGETS`` (from
+    :mod:`unicross.registry`) is the paper's Table 1 as data; the ten modes are instantiations of the four skills.
 Goal features
     g = [one-hot mode (10), d^h (3), current poses (21), target poses (21)] = 55-D.
 Action
@@ -25,32 +25,22 @@ from typing import Dict, List, Tuple
 
 import torch
 
+from unicross import registry as R
 from unicross.geometry import (
     pose_inv, pose_mul, quat_apply, quat_from_axis_angle, quat_inv, quat_mul, quat_positive,
     quat_to_axis_angle, quat_to_euler_xyz, relative_pose, slerp_toward,
 )
 
-SKILLS = ("grasp", "relocate", "rotate", "translate")
-ROTATE_AXES = ("x+", "x-", "y+", "y-", "z+", "z-")
-TRANSLATE_DIRECTIONS = ("z+", "z-")
-MODES: Tuple[str, ...] = (("grasp", "relocate") + tuple(f"rotate_{a}" for a in ROTATE_AXES)
-                          + tuple(f"translate_{d}" for d in TRANSLATE_DIRECTIONS))
-NUM_MODES = len(MODES)  # 10
+SKILLS = R.SKILL_NAMES
+MODES: Tuple[str, ...] = R.MODES
+NUM_MODES = R.NUM_MODES  # 10
 SLOTS = ("x_oh", "q_oh", "x_or", "q_or", "x_hr", "q_hr")
 SLOT_DIMS = {"x_oh": 3, "q_oh": 4, "x_or": 3, "q_or": 4, "x_hr": 3, "q_hr": 4}
 GOAL_DIM = NUM_MODES + 3 + 2 * sum(SLOT_DIMS.values())  # 55
 
 TRACKED, FIXED, FREE = "Tracked", "Fixed", "Free"
-# Paper Table 1. Values are rule names: "fixed", "free" or a tracked rule (see _RULES).
-SKILL_TARGETS: Dict[str, Dict[str, str]] = {
-    "grasp": dict(x_oh="palm", q_oh="free", x_or="fixed", q_or="fixed", x_hr="free", q_hr="free"),
-    "relocate": dict(x_oh="fixed", q_oh="fixed", x_or="interpolate", q_or="interpolate",
-                     x_hr="hand_from_object", q_hr="hand_from_object"),
-    "rotate": dict(x_oh="fixed", q_oh="rotate_about_axis", x_or="fixed", q_or="object_from_hand",
-                   x_hr="fixed", q_hr="fixed"),
-    "translate": dict(x_oh="translate_along_axis", q_oh="fixed", x_or="object_from_hand", q_or="fixed",
-                      x_hr="fixed", q_hr="fixed"),
-}
+# Paper Table 1 (from the registry). Values are rule names: "fixed", "free" or a tracked rule (see _RULES).
+SKILL_TARGETS: Dict[str, Dict[str, str]] = {s.name: s.targets for s in R.SKILLS.values()}
 
 
 def target_kind(rule: str) -> str:
@@ -64,34 +54,20 @@ def target_table() -> Dict[str, Dict[str, List[str]]]:
 
 
 def mode_skill(mode: str) -> str:
-    return mode.split("_")[0]
+    return R.skill_of_mode(mode).name
 
 
 def mode_index(skill: str, axis: str | None = None) -> int:
     """Index into MODES of a skill (with its axis for rotate / direction for translate)."""
-    if skill not in SKILLS:
-        raise ValueError(f"unknown skill {skill!r}; valid skills: {list(SKILLS)}")
-    if skill == "rotate":
-        if axis not in ROTATE_AXES:
-            raise ValueError(f"invalid rotate axis {axis!r}; valid axes: {list(ROTATE_AXES)}")
-        return MODES.index(f"rotate_{axis}")
-    if skill == "translate":
-        if axis not in TRANSLATE_DIRECTIONS:
-            raise ValueError(f"invalid translate direction {axis!r}; valid directions: {list(TRANSLATE_DIRECTIONS)}")
-        return MODES.index(f"translate_{axis}")
-    if axis is not None:
-        raise ValueError(f"skill {skill!r} takes no axis/direction (got {axis!r})")
-    return MODES.index(skill)
+    return MODES.index(R.skill(skill).mode(axis))
 
 
-def _axis_vec(a: str) -> List[float]:
-    v = [0.0, 0.0, 0.0]
-    v["xyz".index(a[0])] = 1.0 if a[1] == "+" else -1.0
-    return v
+def skill_id(name: str) -> int:
+    """Index of a skill in SKILLS (the values of ``MODE_SKILL_ID``)."""
+    return SKILLS.index(R.skill(name).name)
 
 
-MODE_AXES = torch.tensor([[0.0, 0.0, 0.0]] * 2 + [_axis_vec(a) for a in ROTATE_AXES]
-                         + [_axis_vec(d) for d in TRANSLATE_DIRECTIONS])
+MODE_AXES = torch.tensor([R.axis_vector(R.mode_axis(m)) for m in MODES])
 MODE_SKILL_ID = torch.tensor([SKILLS.index(mode_skill(m)) for m in MODES])
 
 

@@ -7,120 +7,162 @@
   r_track = Σ w · error over the six relational poses (position errors saturate at ``track.max_pos_error``)
   r_reg   = pose + wrist_velocity + energy + drop
 
-``TERMS`` names every term once; the task sums exactly these and logs each as ``reward_<name>``.
+Each term is one function registered with :func:`reward_term` (its name and how it reads its
+coefficients from the config); the task sums exactly the registered terms and writes each to
+``info["reward_<name>"]``, and the RL env keys and training logs list them from the registry. A new
+term is one decorated function plus its coefficients in ``configs/reward.yaml``.
 
-:class:`RewardTerms` turns the config into per-mode coefficient tensors, so one batched call
-serves every env whatever its mode. Each term is returned separately for logging.
+Per-skill coefficients become per-mode tensors (:func:`per_mode`), so one batched call serves
+every env whatever its mode.
 """
 from __future__ import annotations
 
-from typing import Dict
+from dataclasses import dataclass
+from typing import Callable, Dict, Optional, Tuple
 
 import torch
 
-from unicross.formulation import MODES, Relational, mode_skill
+from unicross.formulation import MODES, mode_skill
 from unicross.geometry import quat_angle
 
-TERMS = ("contact", "motion", "success", "progress", "track", "pose", "wrist_velocity", "energy", "drop")
 TRACK_WEIGHTS = dict(x_or="w_opr", q_or="w_oqr", x_oh="w_oph", q_oh="w_oqh", x_hr="w_hpr", q_hr="w_hqr")
 
 
-def contact_reward(distance: torch.Tensor, contact: torch.Tensor, force: torch.Tensor,
-                   w_dis: torch.Tensor, w_con: torch.Tensor, w_f: torch.Tensor,
-                   max_distance: float = float("inf")) -> torch.Tensor:
-    """(1/N) Σ_links (-w_dis·min(d_i, max_distance) + w_con·c_i + w_f·f_i); distance/contact/force
-    are [B, L]. The saturation bounds the term when an object is lost (it can fall past the table)."""
-    per_link = -w_dis[:, None] * distance.clamp(max=max_distance) + w_con[:, None] * contact + w_f[:, None] * force
+@dataclass(frozen=True)
+class RewardTerm:
+    """One reward term: ``fn(m, c, mode) -> [B]`` over the step's measurements ``m`` (see
+    ``UniCrossEnv._step_math_eager``), its coefficients ``c`` and the per-env mode; ``coefficients(cfg,
+    device)`` reads ``c`` from the reward config once per env."""
+
+    name: str
+    fn: Callable[[dict, dict, torch.Tensor], torch.Tensor]
+    coefficients: Callable[[dict, object], dict]
+
+
+REGISTRY: Dict[str, RewardTerm] = {}
+
+
+def reward_term(name: str, coefficients: Callable[[dict, object], dict]):
+    """Registers the decorated ``fn(m, c, mode)`` as the reward term ``name``: the task sums it,
+    writes it to ``info["reward_<name>"]``, and the RL env keys and training logs carry it."""
+    def deco(fn):
+        if name in REGISTRY:
+            raise ValueError(f"reward term {name!r} is registered twice")
+        REGISTRY[name] = RewardTerm(name, fn, coefficients)
+        return fn
+    return deco
+
+
+def term_names() -> Tuple[str, ...]:
+    """The registered reward terms, in registration order."""
+    return tuple(REGISTRY)
+
+
+def per_mode(by_skill: dict, device, key: Optional[str] = None) -> torch.Tensor:
+    """[NUM_MODES] tensor of a per-skill coefficient (``by_skill[skill]`` or ``by_skill[skill][key]``)."""
+    return torch.tensor([float(by_skill[mode_skill(m)] if key is None else by_skill[mode_skill(m)][key])
+                         for m in MODES], dtype=torch.float32, device=device)
+
+
+@reward_term("contact", lambda cfg, dev: dict(**{k: per_mode(cfg["contact"], dev, k) for k in ("w_dis", "w_con", "w_f")},
+                                              max_distance=float(cfg["contact_max_distance"])))
+def contact_reward(m: dict, c: dict, mode: torch.Tensor) -> torch.Tensor:
+    """(1/N) Σ_links (-w_dis·min(d_i, max_distance) + w_con·c_i + w_f·f_i) over the [B, L] link
+    distances, contact flags and clipped forces. The saturation bounds the term when an object is
+    lost (it can fall past the table)."""
+    per_link = (-c["w_dis"][mode, None] * m["link_distance"].clamp(max=c["max_distance"])
+                + c["w_con"][mode, None] * m["contact"].float() + c["w_f"][mode, None] * m["force_clipped"])
     return per_link.mean(dim=-1)
 
 
-def motion_reward(speed_along_axis: torch.Tensor, cap: torch.Tensor, w_p: torch.Tensor) -> torch.Tensor:
+@reward_term("motion", lambda cfg, dev: dict(w_p=per_mode(cfg["motion"], dev)))
+def motion_reward(m: dict, c: dict, mode: torch.Tensor) -> torch.Tensor:
     """w_p · min(v_o^h · d^h, v_max)."""
-    return w_p * torch.minimum(speed_along_axis, cap)
+    return c["w_p"][mode] * torch.minimum(m["speed_along_axis"], m["speed_cap"])
 
 
-def tracking_reward(cur: Relational, tgt: Relational, w_pos: torch.Tensor, w_rot: torch.Tensor,
-                    max_pos: float = float("inf")) -> torch.Tensor:
-    """Σ w_pos·min(||x - x̂||, max_pos)² + w_rot·A(q, q̂) over the three relational poses (o in h,
-    o in r, h in r); ``w_pos``/``w_rot`` are [3] weights in that order. The position saturation
-    bounds the term when an object is lost (a dropped object can roll away for ever); angles are
-    bounded by π already."""
-    xc, qc = cur.poses()
-    xt, qt = tgt.poses()
-    pos = torch.linalg.norm(xc - xt, dim=-1).clamp(max=max_pos) ** 2
-    return (pos * w_pos).sum(-1) + (quat_angle(qc, qt) * w_rot).sum(-1)
-
-
-def success_reward(success: torch.Tensor, w_success: torch.Tensor) -> torch.Tensor:
+@reward_term("success", lambda cfg, dev: dict(w=per_mode(cfg["success"], dev)))
+def success_reward(m: dict, c: dict, mode: torch.Tensor) -> torch.Tensor:
     """w_success · [the mode's success holds at this step]."""
-    return w_success * success.float()
+    return c["w"][mode] * m["success"].float()
 
 
-def progress_reward(err_prev: torch.Tensor, err: torch.Tensor, w_pos: torch.Tensor, w_rot: torch.Tensor,
-                    max_pos: float = float("inf")) -> torch.Tensor:
+@reward_term("progress", lambda cfg, dev: dict(w_pos=per_mode(cfg["progress"], dev, "w_pos"),
+                                               w_rot=per_mode(cfg["progress"], dev, "w_rot"),
+                                               max_pos=float(cfg["track"]["max_pos_error"])))
+def progress_reward(m: dict, c: dict, mode: torch.Tensor) -> torch.Tensor:
     """w_pos·(e_{t-1} − e_t) + w_rot·(θ_{t-1} − θ_t): how much closer the object came to its final
-    pose over the step (``err`` [B, 2]: position error, saturated at ``max_pos``, and angle). A
-    potential-based shaping term (Ng et al., 1999, with γ≈1): over an episode it sums to the
-    reduction of the error from start to end, whatever the path."""
-    pos_prev, pos = err_prev[:, 0].clamp(max=max_pos), err[:, 0].clamp(max=max_pos)
-    return w_pos * (pos_prev - pos) + w_rot * (err_prev[:, 1] - err[:, 1])
+    pose over the step (``goal_err``/``goal_err_prev`` [B, 2]: position error, saturated at
+    ``max_pos``, and angle). A potential-based shaping term (Ng et al., 1999, with γ≈1): over an
+    episode it sums to the reduction of the error from start to end, whatever the path."""
+    prev, err = m["goal_err_prev"], m["goal_err"]
+    pos_prev, pos = prev[:, 0].clamp(max=c["max_pos"]), err[:, 0].clamp(max=c["max_pos"])
+    return c["w_pos"][mode] * (pos_prev - pos) + c["w_rot"][mode] * (prev[:, 1] - err[:, 1])
 
 
-def pose_reward(finger_q: torch.Tensor, finger_q0: torch.Tensor, w_pose: float) -> torch.Tensor:
+def _track_coefficients(cfg: dict, dev) -> dict:
+    t = cfg["track"]
+    return dict(pos=torch.tensor([t[TRACK_WEIGHTS[s]] for s in ("x_oh", "x_or", "x_hr")], device=dev),
+                rot=torch.tensor([t[TRACK_WEIGHTS[s]] for s in ("q_oh", "q_or", "q_hr")], device=dev),
+                max_pos=float(t["max_pos_error"]), off=bool(cfg.get("no_track_reward", False)))
+
+
+@reward_term("track", _track_coefficients)
+def tracking_reward(m: dict, c: dict, mode: torch.Tensor) -> torch.Tensor:
+    """Σ w_pos·min(||x - x̂||, max_pos)² + w_rot·A(q, q̂) over the three relational poses (o in h,
+    o in r, h in r). The position saturation bounds the term when an object is lost (a dropped
+    object can roll away for ever); angles are bounded by π already. 0 under the
+    ``no_track_reward`` ablation."""
+    xc, qc = m["relational"].poses()
+    xt, qt = m["reward_targets"].poses()
+    pos = torch.linalg.norm(xc - xt, dim=-1).clamp(max=c["max_pos"]) ** 2
+    r = (pos * c["pos"]).sum(-1) + (quat_angle(qc, qt) * c["rot"]).sum(-1)
+    return torch.zeros_like(r) if c["off"] else r
+
+
+@reward_term("pose", lambda cfg, dev: dict(w=float(cfg["reg"]["w_pose"])))
+def pose_reward(m: dict, c: dict, mode: torch.Tensor) -> torch.Tensor:
     """w_pose · Σ (q_i - q_i,0)² over finger joints."""
-    return w_pose * ((finger_q - finger_q0) ** 2).sum(-1)
+    return c["w"] * ((m["finger_qpos"] - m["finger_qpos0"]) ** 2).sum(-1)
 
 
-def wrist_velocity_reward(lin_vel: torch.Tensor, ang_vel: torch.Tensor, w_vel: float, w_ang: float) -> torch.Tensor:
-    return w_vel * (lin_vel ** 2).sum(-1) + w_ang * (ang_vel ** 2).sum(-1)
+@reward_term("wrist_velocity", lambda cfg, dev: dict(w_vel=float(cfg["reg"]["w_vel"]), w_ang=float(cfg["reg"]["w_ang"])))
+def wrist_velocity_reward(m: dict, c: dict, mode: torch.Tensor) -> torch.Tensor:
+    """w_vel·||ẋ_h||² + w_ang·||ω_h||²."""
+    return c["w_vel"] * (m["hand_lin_vel"] ** 2).sum(-1) + c["w_ang"] * (m["hand_ang_vel"] ** 2).sum(-1)
 
 
-def energy_reward(torque: torch.Tensor, w_tau: float) -> torch.Tensor:
-    return w_tau * (torque ** 2).sum(-1)
+@reward_term("energy", lambda cfg, dev: dict(w=float(cfg["reg"]["w_tau"])))
+def energy_reward(m: dict, c: dict, mode: torch.Tensor) -> torch.Tensor:
+    """w_tau · ||τ||² over the finger joints."""
+    return c["w"] * (m["finger_torque"] ** 2).sum(-1)
 
 
-def drop_reward(dropped: torch.Tensor, w_drop: float) -> torch.Tensor:
-    return w_drop * dropped.float()
+@reward_term("drop", lambda cfg, dev: dict(w=float(cfg["reg"]["w_drop"])))
+def drop_reward(m: dict, c: dict, mode: torch.Tensor) -> torch.Tensor:
+    """w_drop · [dropped at this step]."""
+    return c["w"] * m["drop"].float()
 
 
 class RewardTerms:
-    """Per-mode coefficients from the reward config; ``__call__`` returns every term."""
+    """Every registered term with its coefficients read from the reward config; ``__call__``
+    returns each term separately (for logging) and :meth:`total` their sum."""
 
     def __init__(self, cfg: dict, device, no_track_reward: bool = False):
-        def per_mode(getter):
-            return torch.tensor([getter(mode_skill(m)) for m in MODES], dtype=torch.float32, device=device)
-        self.w_dis = per_mode(lambda s: cfg["contact"][s]["w_dis"])
-        self.w_con = per_mode(lambda s: cfg["contact"][s]["w_con"])
-        self.w_f = per_mode(lambda s: cfg["contact"][s]["w_f"])
-        self.w_p = per_mode(lambda s: cfg["motion"][s])
-        self.max_distance = float(cfg["contact_max_distance"])
-        self.w_success = per_mode(lambda s: cfg["success"][s])
-        self.w_prog_pos = per_mode(lambda s: cfg["progress"][s]["w_pos"])
-        self.w_prog_rot = per_mode(lambda s: cfg["progress"][s]["w_rot"])
-        t = cfg["track"]
-        self.max_pos = float(t["max_pos_error"])
-        self.track_pos = torch.tensor([t[TRACK_WEIGHTS[s]] for s in ("x_oh", "x_or", "x_hr")], device=device)
-        self.track_rot = torch.tensor([t[TRACK_WEIGHTS[s]] for s in ("q_oh", "q_or", "q_hr")], device=device)
-        self.reg = dict(cfg["reg"])
-        self.no_track_reward = no_track_reward
+        cfg = dict(cfg, no_track_reward=no_track_reward)
+        self.terms = [(t, t.coefficients(cfg, device)) for t in REGISTRY.values()]
 
-    def __call__(self, mode, m: dict) -> Dict[str, torch.Tensor]:
+    def __call__(self, mode: torch.Tensor, m: dict) -> Dict[str, torch.Tensor]:
         """``m`` holds the step's measurements (see UniCrossEnv.evaluate)."""
-        terms = dict(
-            contact=contact_reward(m["link_distance"], m["contact"].float(), m["force_clipped"],
-                                   self.w_dis[mode], self.w_con[mode], self.w_f[mode], self.max_distance),
-            motion=motion_reward(m["speed_along_axis"], m["speed_cap"], self.w_p[mode]),
-            success=success_reward(m["success"], self.w_success[mode]),
-            progress=progress_reward(m["goal_err_prev"], m["goal_err"], self.w_prog_pos[mode],
-                                     self.w_prog_rot[mode], self.max_pos),
-            track=tracking_reward(m["relational"], m["reward_targets"], self.track_pos, self.track_rot,
-                                  self.max_pos),
-            pose=pose_reward(m["finger_qpos"], m["finger_qpos0"], self.reg["w_pose"]),
-            wrist_velocity=wrist_velocity_reward(m["hand_lin_vel"], m["hand_ang_vel"],
-                                                 self.reg["w_vel"], self.reg["w_ang"]),
-            energy=energy_reward(m["finger_torque"], self.reg["w_tau"]),
-            drop=drop_reward(m["drop"], self.reg["w_drop"]),
-        )
-        if self.no_track_reward:
-            terms["track"] = torch.zeros_like(terms["track"])
-        return terms
+        return {t.name: t.fn(m, c, mode) for t, c in self.terms}
+
+    @property
+    def names(self) -> Tuple[str, ...]:
+        return tuple(t.name for t, _ in self.terms)
+
+    def coefficients(self, name: str) -> dict:
+        """The coefficients of term ``name`` (the dict its function reads at every step)."""
+        for t, c in self.terms:
+            if t.name == name:
+                return c
+        raise KeyError(f"no reward term {name!r}; terms: {list(self.names)}")

@@ -16,7 +16,7 @@ Batch layout (what TorchRL's GAE and ``ClipPPOLoss`` read), ``[num_envs, T]``: `
 ``action_log_prob``, ``loc``, ``scale``, and under ``next``: the observation after the step (the
 last one of an episode, before the reset), ``reward``, ``done``, ``terminated`` (object dropped),
 ``truncated`` (episode length), and ``info`` (the task's per-term rewards and flags,
-:data:`unicross.rl.env.INFO_FLOAT` / ``INFO_BOOL``).
+:func:`unicross.rl.env.info_float_keys` / ``INFO_BOOL``).
 """
 from __future__ import annotations
 
@@ -28,7 +28,7 @@ import torch
 import torch.multiprocessing as mp
 from tensordict import TensorDict
 
-from unicross.rl.env import INFO_BOOL, INFO_FLOAT, split_obs
+from unicross.rl.env import INFO_BOOL, info_float_keys, split_obs
 
 OBS_KEYS = ("hand", "object", "goal")
 
@@ -38,7 +38,7 @@ def make_buffer(n: int, horizon: int, dims: dict, n_act: int, device="cpu") -> T
     b = (n, horizon)
     z = lambda *s, dtype=torch.float32: torch.zeros(b + s, dtype=dtype, device=device)  # noqa: E731
     obs = {k: z(dims[k]) for k in OBS_KEYS}
-    info = {k: z(1) for k in INFO_FLOAT} | {k: z(1, dtype=torch.bool) for k in INFO_BOOL}
+    info = {k: z(1) for k in info_float_keys()} | {k: z(1, dtype=torch.bool) for k in INFO_BOOL}
     nxt = {k: z(dims[k]) for k in OBS_KEYS} | dict(
         reward=z(1), done=z(1, dtype=torch.bool), terminated=z(1, dtype=torch.bool),
         truncated=z(1, dtype=torch.bool), info=TensorDict(info, batch_size=b, device=device))
@@ -78,7 +78,7 @@ class Rollout:
         leaves = {k: buf.get(k) for k in buf.keys(include_nested=True, leaves_only=True)}
         nxt_obs = [leaves[("next", k)] for k in OBS_KEYS]
         obs_buf = [leaves[k] for k in OBS_KEYS]
-        info_keys = [(k, leaves[("next", "info", k)]) for k in INFO_FLOAT + INFO_BOOL]
+        info_keys = [(k, leaves[("next", "info", k)]) for k in info_float_keys() + INFO_BOOL]
         act, logp, loc_b, scale_b = leaves["action"], leaves["action_log_prob"], leaves["loc"], leaves["scale"]
         rew, done_b = leaves[("next", "reward")], leaves[("next", "done")]
         term_b, trunc_b = leaves[("next", "terminated")], leaves[("next", "truncated")]

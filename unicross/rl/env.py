@@ -18,11 +18,16 @@ from tensordict import TensorDict, TensorDictBase
 from torchrl.data import Bounded, Categorical, Composite, Unbounded
 from torchrl.envs import EnvBase
 
-from unicross.rewards import TERMS as REWARD_TERMS
+from unicross.rewards import term_names
 
-INFO_FLOAT = ("rotation", "translation", "relocate_pos_err", "relocate_rot_err") + \
-    tuple(f"reward_{t}" for t in REWARD_TERMS)
+INFO_METRICS = ("rotation", "translation", "relocate_pos_err", "relocate_rot_err")
 INFO_BOOL = ("success", "drop", "nonfinite")
+
+
+def info_float_keys() -> tuple:
+    """The float ``info`` entries an RL env carries: the protocol metrics and every registered
+    reward term (read from the registry when called, so a term registered later is included)."""
+    return INFO_METRICS + tuple(f"reward_{t}" for t in term_names())
 
 
 def split_obs(obs: dict) -> tuple:
@@ -68,7 +73,8 @@ class ManiSkillEnv(EnvBase):
         dims = dict(hand=obs["hand"].shape[-1], goal=obs["goal"].shape[-1],
                     object=sum(v.shape[-1] for v in obs["object"].values()))
         dev = self.device
-        info = Composite({k: Unbounded(b + (1,), device=dev) for k in INFO_FLOAT}, shape=b, device=dev)
+        self._info_float = info_float_keys()
+        info = Composite({k: Unbounded(b + (1,), device=dev) for k in self._info_float}, shape=b, device=dev)
         for k in INFO_BOOL:
             info[k] = Categorical(2, b + (1,), dtype=torch.bool, device=dev)
         self.observation_spec = Composite(hand=Unbounded(b + (dims["hand"],), device=dev),
@@ -86,7 +92,7 @@ class ManiSkillEnv(EnvBase):
     # ------------------------------------------------------------------ conversions
     def _pack(self, obs: dict, info: dict) -> TensorDict:
         td = obs_to_td(obs, self.device)
-        td["info"] = TensorDict({k: info[k].reshape(-1, 1).float() for k in INFO_FLOAT}
+        td["info"] = TensorDict({k: info[k].reshape(-1, 1).float() for k in self._info_float}
                                 | {k: info[k].reshape(-1, 1).bool() for k in INFO_BOOL}, batch_size=td.batch_size)
         return td[0] if self._squeeze else td
 
@@ -101,7 +107,7 @@ class ManiSkillEnv(EnvBase):
         obs, info = self.task.reset(seed=seed, options=options)
         info = dict(info)
         n = self.task.num_envs
-        for k in INFO_FLOAT + INFO_BOOL:
+        for k in self._info_float + INFO_BOOL:
             info.setdefault(k, torch.zeros(n, device=self.device))
         td = self._pack(obs, info)
         zeros = torch.zeros(self.batch_size + (1,), dtype=torch.bool, device=self.device)

@@ -10,7 +10,7 @@ from unicross.rl.models import make_models
 
 
 SHIPPED_DIR = Path(__file__).resolve().parent.parent / "checkpoints"
-SHIPPED_KEYS = ("policy", "obs_dims", "n_act", "config", "skill", "axis", "hand", "env_id", "env_kwargs",
+SHIPPED_KEYS = ("policy", "obs_dims", "n_act", "modes", "config", "skill", "axis", "hand", "env_id", "env_kwargs",
                 "iteration", "frames", "git_commit", "commits")
 
 
@@ -51,10 +51,23 @@ def load_policy(path, device="cpu"):
     ck = torch.load(path, map_location=device, weights_only=False)
     if not isinstance(ck, dict) or "policy" not in ck or "obs_dims" not in ck:
         raise ValueError(f"{path} is not a UniCross policy checkpoint")
+    check_modes(ck, path)
     policy, _, _ = make_models(ck["obs_dims"], ck["n_act"], None, ck["config"]["model"])
     policy.load_state_dict(ck["policy"])
     policy.to(device).eval()
     return policy, ck
+
+
+def check_modes(ck: dict, path) -> None:
+    """Refuses a checkpoint whose goal (mode one-hot) differs from this install's skill registry:
+    its network would read another layout of the observation. Checkpoints without ``modes``
+    (written before it was stored) are checked by the goal size alone."""
+    from unicross import formulation as F
+    goal, modes = ck["obs_dims"].get("goal"), ck.get("modes")
+    if goal != F.GOAL_DIM or (modes is not None and list(modes) != list(F.MODES)):
+        raise ValueError(f"{path} was trained with a {goal}-D goal over modes {modes or '(not stored)'}; this "
+                         f"install's skill registry gives a {F.GOAL_DIM}-D goal over {list(F.MODES)}: retrain it, "
+                         f"or load it with the registry it was trained with")
 
 
 @torch.no_grad()

@@ -1,7 +1,6 @@
-"""PPO for one UniCross expert with TorchRL building blocks.
-
-    LeanCollector -> GAE -> TensorDict replay buffer (mini-batches) -> ClipPPOLoss -> Adam
-    (+ KL-adaptive learning rate, grad-norm clipping, running observation normalisation)
+"""The runner that trains one UniCross expert with PPO (rsl_rl's split: the algorithm, GAE ->
+minibatches -> ClipPPOLoss -> Adam with a KL-adaptive rate, is :class:`unicross.rl.algorithm.PPO`;
+this module owns collection, evaluation, logging, checkpoints and resume).
 
 On the CPU the collector runs one env per worker process with the actor inside the worker
 (:mod:`unicross.rl.collector`); the main process does GAE and the update.
@@ -25,21 +24,16 @@ from typing import Optional
 import numpy as np
 import torch
 from tensordict import TensorDict
-from torchrl.data import Bounded, LazyTensorStorage, TensorDictReplayBuffer
-from torchrl.data.replay_buffers.samplers import SamplerWithoutReplacement
-from torchrl.objectives import ClipPPOLoss
-from torchrl.objectives.value import GAE
 from tqdm import tqdm
 
 from unicross import formulation as F
+from unicross import registry as R
 from unicross.config import deep_merge, load_config
-from unicross.rewards import TERMS as REWARD_TERMS
+from unicross.rewards import term_names
+from unicross.rl.algorithm import PPO
 from unicross.rl.collector import LeanCollector
-from unicross.rl.models import OBS_KEYS, make_models
+from unicross.rl.models import OBS_KEYS  # noqa: F401  (re-exported for benchmarks)
 
-SKILL_ENV = {"grasp": "UniCross-Grasp-v1", "relocate": "UniCross-Relocate-v1", "rotate": "UniCross-Rotate-v1",
-             "translate": "UniCross-Translate-v1"}
-DEFAULT_HORIZON = {"grasp": 64, "relocate": 64, "rotate": 8, "translate": 8}
 CKPT_NAME = "checkpoint.pt"
 
 
@@ -61,11 +55,18 @@ def resolve_horizon(collector_cfg: dict, skill: str, num_envs: int) -> int:
         return int(collector_cfg["horizon"])
     if collector_cfg.get("frames_per_batch"):
         return -(-int(collector_cfg["frames_per_batch"]) // num_envs)
-    return DEFAULT_HORIZON[skill]
-CSV_FIELDS = ["iteration", "frames", "wall_s", "fps", "collect_s", "update_s", "reward_raw", "reward_scaled", "episodes",
-              "episode_return", "success_rate", "loss_objective", "loss_critic", "entropy", "kl", "clip_fraction",
-              "ESS", "explained_variance", "value_clip_fraction", "grad_norm_actor", "grad_norm_critic", "lr",
-              "value_mean", "value_std", "nonfinite"] + [f"reward_{t}" for t in REWARD_TERMS]
+    return R.skill(skill).ppo_horizon
+
+
+CSV_BASE = ["iteration", "frames", "wall_s", "fps", "collect_s", "update_s", "reward_raw", "reward_scaled", "episodes",
+            "episode_return", "success_rate", "loss_objective", "loss_critic", "entropy", "kl", "clip_fraction",
+            "ESS", "explained_variance", "value_clip_fraction", "grad_norm_actor", "grad_norm_critic", "lr",
+            "value_mean", "value_std", "nonfinite"]
+
+
+def csv_fields() -> list:
+    """metrics.csv columns: the training statistics and the mean of every registered reward term."""
+    return CSV_BASE + [f"reward_{t}" for t in term_names()]
 
 
 def git_commit() -> str:
@@ -92,6 +93,8 @@ def open_run(run_dir: Path, resume: bool, overrides: Optional[dict], config_name
         if not ckpt_path.exists():
             raise FileNotFoundError(f"cannot resume: no checkpoint at {ckpt_path}")
         ckpt = torch.load(ckpt_path, map_location="cpu", weights_only=False)
+        from unicross.rl.policy_io import check_modes
+        check_modes(ckpt, ckpt_path)
         return ckpt, deep_merge(ckpt["config"], overrides)
     if ckpt_path.exists():
         raise FileExistsError(f"{ckpt_path} exists: pass --resume to continue it or choose another --out")
@@ -99,8 +102,9 @@ def open_run(run_dir: Path, resume: bool, overrides: Optional[dict], config_name
 
 
 def env_kwargs_for(skill: str, axis: Optional[str], hand: str, env_cfg: dict) -> dict:
-    F.mode_index(skill, axis)  # validates skill and axis before any simulation
-    kw = dict(hand=hand, randomize=env_cfg["randomize"], reconfiguration_freq=env_cfg["reconfiguration_freq"])
+    """The env constructor arguments of one expert (validates skill and axis before any simulation)."""
+    kw = dict(R.skill(skill).env_kwargs(axis), hand=hand, randomize=env_cfg["randomize"],
+              reconfiguration_freq=env_cfg["reconfiguration_freq"])
     if env_cfg.get("task_config"):
         kw["config"] = env_cfg["task_config"]
     if env_cfg.get("reward_config"):
@@ -109,10 +113,6 @@ def env_kwargs_for(skill: str, axis: Optional[str], hand: str, env_cfg: dict) ->
         kw["objects"] = env_cfg["objects"]
     if env_cfg.get("object_limit") is not None:
         kw["object_limit"] = env_cfg["object_limit"]
-    if skill == "rotate":
-        kw["axis"] = axis
-    if skill == "translate":
-        kw["direction"] = axis
     return kw
 
 
@@ -142,9 +142,7 @@ class PPOTrainer:
         # the code this segment runs (read once: HEAD may move while a long run trains)
         self.commit = git_commit()
         self.commits = list((self.ckpt or {}).get("commits", [])) + [self.commit]
-        self.env_id = SKILL_ENV[skill] if skill in SKILL_ENV else None
-        if self.env_id is None:
-            raise ValueError(f"unknown skill {skill!r}; valid skills: {list(SKILL_ENV)}")
+        self.env_id = R.skill(skill).env_id
         self.env_kwargs = env_kwargs_for(skill, axis, hand, cfg["env"])
         self.progress = progress
         self._seed_everything(cfg["seed"])
@@ -159,26 +157,7 @@ class PPOTrainer:
             torch.set_num_threads(os.cpu_count() or 1)
         self.device = self.collector.device
         dims, self.n_act = self.collector.dims, self.collector.n_act
-        self.policy, self.value, self.norm = make_models(dims, self.n_act, Bounded(-1.0, 1.0, (self.n_act,)),
-                                                         cfg["model"])
-        self.policy.to(self.device)
-        self.value.to(self.device)
-        lc = cfg["loss"]
-        if cfg["optim"]["schedule"] not in ("fixed", "adaptive"):
-            raise ValueError(f"optim.schedule must be 'fixed' or 'adaptive', not {cfg['optim']['schedule']!r}")
-        # the critic loss is taken in normalised return units (value targets standardised by
-        # running statistics), with PPO-style value clipping around the predictions that collected
-        self.loss = ClipPPOLoss(self.policy, self.value.critic, clip_epsilon=lc["clip_epsilon"],
-                                entropy_bonus=True, entropy_coeff=lc["entropy_coeff"],
-                                critic_coeff=lc["critic_coeff"], loss_critic_type=lc["loss_critic_type"],
-                                normalize_advantage=lc["normalize_advantage"], clip_value=lc["clip_value"])
-        self.loss.set_keys(value="state_value_norm", value_target="value_target_norm")
-        self._actor_params = list(self.policy.parameters())
-        self._critic_params = list(self.value.critic.parameters())
-        self.gae = GAE(gamma=cfg["gae"]["gamma"], lmbda=cfg["gae"]["lmbda"], value_network=self.value,
-                       average_gae=False)
-        self.optim = torch.optim.Adam(self.loss.parameters(), lr=cfg["optim"]["lr"])
-        self.lr = cfg["optim"]["lr"]
+        self.algo = PPO(dims, self.n_act, cfg, self.collector.frames_per_batch, self.device)
         self.iteration, self.frames = 0, 0
         self._writer = None  # TensorBoard, open while train() runs
         self.wall_s = 0.0  # training wall-clock over all segments of the run (collection, updates, evaluations)
@@ -186,12 +165,7 @@ class PPOTrainer:
         self.dims = dims
         if self.ckpt is not None:
             self._load_state(self.ckpt)
-        self.collector.set_actor(self.policy.module[0].module)  # after loading: the workers share these weights
-        self.batch_envs = num_envs
-        self.frames_per_batch = self.collector.frames_per_batch
-        self.minibatch = min(cfg["optim"]["minibatch_size"], self.frames_per_batch)
-        self.rb = TensorDictReplayBuffer(storage=LazyTensorStorage(self.frames_per_batch, device=self.device),
-                                         sampler=SamplerWithoutReplacement(), batch_size=self.minibatch)
+        self.collector.set_actor(self.algo.actor)  # after loading: the workers share these weights
         self._ep_return = torch.zeros(num_envs, 1, device=self.device)
 
     # ------------------------------------------------------------------ state
@@ -200,21 +174,23 @@ class PPOTrainer:
         np.random.seed(seed)
         random.seed(seed)
 
+    # the algorithm's parts, for inspection
+    policy = property(lambda self: self.algo.policy)
+    value = property(lambda self: self.algo.value)
+    norm = property(lambda self: self.algo.norm)
+    optim = property(lambda self: self.algo.optim)
+
     def state(self) -> dict:
-        return dict(policy=self.policy.state_dict(), value=self.value.state_dict(), optim=self.optim.state_dict(),
-                    iteration=self.iteration, frames=self.frames, lr=self.lr, wall_s=self._wall(), config=self.cfg, skill=self.skill,
+        return dict(**self.algo.state_dict(),
+                    iteration=self.iteration, frames=self.frames, wall_s=self._wall(), config=self.cfg, skill=self.skill,
                     axis=self.axis, hand=self.hand, env_id=self.env_id, env_kwargs=self.env_kwargs,
-                    obs_dims=self.dims, n_act=self.n_act, git_commit=self.commit, commits=self.commits,
+                    obs_dims=self.dims, n_act=self.n_act, modes=list(F.MODES), git_commit=self.commit, commits=self.commits,
                     rng=dict(torch=torch.get_rng_state(), numpy=np.random.get_state(), python=random.getstate()))
 
     def _load_state(self, ck: dict):
-        self.policy.load_state_dict(ck["policy"])
-        self.value.load_state_dict(ck["value"])
-        self.optim.load_state_dict(ck["optim"])
-        self.iteration, self.frames, self.lr = ck["iteration"], ck["frames"], ck["lr"]
+        self.algo.load_state_dict(ck)
+        self.iteration, self.frames = ck["iteration"], ck["frames"]
         self.wall_s, self._wall_mark = float(ck.get("wall_s", 0.0)), time.perf_counter()
-        for g in self.optim.param_groups:
-            g["lr"] = self.lr
         torch.set_rng_state(ck["rng"]["torch"])
         np.random.set_state(ck["rng"]["numpy"])
         random.setstate(ck["rng"]["python"])
@@ -273,86 +249,6 @@ class PPOTrainer:
             out.update(episode_return=float(r.mean()), success_rate=float(s.mean()))
         return out
 
-    def _update(self, data: TensorDict) -> dict:
-        """One PPO update on a collected batch ``data`` [..., T]: GAE on scaled rewards, return
-        statistics, then ``mini_epochs`` passes of minibatches through ClipPPOLoss (policy) and
-        the clipped critic loss in normalised units; actor and critic gradients are clipped
-        separately. Returns the mean of the loss module's own diagnostics."""
-        oc = self.cfg["optim"]
-        fitted_first = bool(self.norm.count < 1)
-        if fitted_first:  # first batch: fit the observation statistics before any update, and express
-            # the behaviour distribution under them (the initial action mean is ~0 either way)
-            self.norm.update({k: data[k] for k in OBS_KEYS})
-            with torch.no_grad():
-                obs = data.select(*OBS_KEYS).clone()
-                loc_scale = self.policy.module[0](obs)
-                data["loc"], data["scale"] = loc_scale["loc"], loc_scale["scale"]
-                data["action_log_prob"] = self.policy.get_dist(obs).log_prob(data["action"])
-        data["next", "reward"] = data["next", "reward"] * self.cfg["gae"]["reward_scale"]
-        with torch.no_grad():
-            self.gae(data)
-            vn = self.value.value_norm
-            vn.update(data["value_target"])
-            data["value_target_norm"] = vn.normalize(data["value_target"])
-            data["state_value_norm"] = vn.normalize(data["state_value"])  # old predictions, new units
-        flat = data.reshape(-1)
-        self.rb.empty()
-        self.rb.extend(flat)
-        n_mb = max(1, self.frames_per_batch // self.minibatch)
-        keys = ("loss_objective", "loss_critic", "entropy", "kl_approx", "clip_fraction", "ESS",
-                "explained_variance", "value_clip_fraction")
-        stats = {k: 0.0 for k in keys}
-        stats.update(grad_norm_actor=0.0, grad_norm_critic=0.0)
-        count, stopped = 0, False
-        kl_stop = oc.get("kl_stop")
-        for _ in range(oc["mini_epochs"]):
-            if stopped:
-                break
-            for _ in range(n_mb):
-                mb = self.rb.sample()
-                losses = self.loss(mb)
-                loss = losses["loss_objective"] + losses["loss_critic"]
-                if "loss_entropy" in losses.keys():
-                    loss = loss + losses["loss_entropy"]
-                self.optim.zero_grad(set_to_none=True)
-                loss.backward()
-                ga = torch.nn.utils.clip_grad_norm_(self._actor_params, oc["max_grad_norm"])
-                gc = torch.nn.utils.clip_grad_norm_(self._critic_params, oc["max_grad_norm_critic"])
-                self.optim.step()
-                klv = float(losses["kl_approx"])
-                self._schedule_lr(klv)
-                for k in keys:
-                    if k in losses.keys():
-                        stats[k] += float(losses[k].detach().float().mean())
-                stats["grad_norm_actor"] += float(ga)
-                stats["grad_norm_critic"] += float(gc)
-                count += 1
-                if kl_stop is not None and klv > kl_stop:  # the policy moved far enough for this batch
-                    stopped = True
-                    break
-        if not fitted_first:
-            self.norm.update({k: flat[k] for k in OBS_KEYS})
-        out = {k: v / count for k, v in stats.items()}
-        out["kl"] = out.pop("kl_approx")
-        out["lr"] = self.lr
-        out["minibatch_steps"] = count
-        out["value_mean"], out["value_std"] = float(vn.mean), float(vn.std())
-        return out
-
-    def _schedule_lr(self, kl: float) -> None:
-        """``optim.schedule``: ``fixed``, or ``adaptive`` (rl_games): the rate shrinks by 1.5 when
-        the minibatch KL exceeds twice ``kl_threshold`` and grows by 1.5 below half of it, within
-        [``lr_min``, ``lr_max``] (a floor that keeps learning alive)."""
-        oc = self.cfg["optim"]
-        if oc["schedule"] == "fixed":
-            return
-        if kl > 2.0 * oc["kl_threshold"]:
-            self.lr = max(self.lr / 1.5, oc["lr_min"])
-        elif kl < 0.5 * oc["kl_threshold"]:
-            self.lr = min(self.lr * 1.5, oc["lr_max"])
-        for g in self.optim.param_groups:
-            g["lr"] = self.lr
-
     def train(self, max_iterations: Optional[int] = None, eval_at_ends: bool = True) -> dict:
         """Collect and update until ``collector.total_frames`` (or ``max_iterations`` more
         iterations), with the held-out evaluations of ``logging``; returns their summaries."""
@@ -391,7 +287,7 @@ class PPOTrainer:
                 reward_raw = float(data["next", "reward"].mean())
                 ep["nonfinite"] = int(data["next", "info", "nonfinite"].sum())
                 t0 = time.perf_counter()
-                up = self._update(data)
+                up = self.algo.update(data)
                 t_update = time.perf_counter() - t0
                 terms = {k: float(data["next", "info", k].mean()) for k in data["next", "info"].keys()
                          if k.startswith("reward_")}
@@ -485,7 +381,7 @@ class PPOTrainer:
 
     def _log(self, row: dict):
         self._log_json(row)
-        self._append_csv("metrics.csv", row, CSV_FIELDS)
+        self._append_csv("metrics.csv", row, csv_fields())
         if self._writer is not None:
             for k, v in row.items():
                 if k not in ("iteration", "frames") and isinstance(v, (int, float)):

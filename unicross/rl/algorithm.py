@@ -1,0 +1,164 @@
+"""The PPO algorithm on its own: batches in, losses out (rsl_rl's algorithm/runner split).
+
+:class:`PPO` owns the networks (actor, critic, running observation and return statistics), the
+TorchRL loss (``ClipPPOLoss`` with a normalised, clipped critic), GAE, the optimiser and the
+KL-adaptive learning rate. It knows nothing of environments, files or logs: the runner
+(:class:`unicross.rl.ppo.PPOTrainer`) collects batches, calls :meth:`PPO.update` and logs the
+dict it returns. So the update can be tested on synthetic TensorDicts without a simulator.
+
+A batch is a TensorDict ``[..., T]`` with the collector's keys: ``hand``, ``object``, ``goal``,
+``action``, ``action_log_prob``, ``loc``, ``scale`` and ``next`` (``hand``, ``object``, ``goal``,
+``reward``, ``done``, ``terminated``, ``truncated``).
+"""
+from __future__ import annotations
+
+from typing import Dict
+
+import torch
+from tensordict import TensorDict
+from torchrl.data import Bounded, LazyTensorStorage, TensorDictReplayBuffer
+from torchrl.data.replay_buffers.samplers import SamplerWithoutReplacement
+from torchrl.objectives import ClipPPOLoss
+from torchrl.objectives.value import GAE
+
+from unicross.rl.models import OBS_KEYS, make_models
+
+LOSS_KEYS = ("loss_objective", "loss_critic", "entropy", "kl_approx", "clip_fraction", "ESS",
+             "explained_variance", "value_clip_fraction")
+
+
+class PPO:
+    """PPO for one policy (``cfg``: the ``model``, ``loss``, ``gae`` and ``optim`` sections of
+    ``configs/ppo.yaml``) on observations of sizes ``dims`` with ``n_act`` actions in [-1, 1];
+    ``frames_per_batch`` sizes the replay buffer the minibatches are drawn from."""
+
+    def __init__(self, dims: Dict[str, int], n_act: int, cfg: dict, frames_per_batch: int, device="cpu"):
+        self.cfg = cfg
+        oc = cfg["optim"]
+        if oc["schedule"] not in ("fixed", "adaptive"):
+            raise ValueError(f"optim.schedule must be 'fixed' or 'adaptive', not {oc['schedule']!r}")
+        self.policy, self.value, self.norm = make_models(dims, n_act, Bounded(-1.0, 1.0, (n_act,)), cfg["model"])
+        self.policy.to(device)
+        self.value.to(device)
+        lc = cfg["loss"]
+        # the critic loss is taken in normalised return units (value targets standardised by
+        # running statistics), with PPO-style value clipping around the predictions that collected
+        self.loss = ClipPPOLoss(self.policy, self.value.critic, clip_epsilon=lc["clip_epsilon"],
+                                entropy_bonus=True, entropy_coeff=lc["entropy_coeff"],
+                                critic_coeff=lc["critic_coeff"], loss_critic_type=lc["loss_critic_type"],
+                                normalize_advantage=lc["normalize_advantage"], clip_value=lc["clip_value"])
+        self.loss.set_keys(value="state_value_norm", value_target="value_target_norm")
+        self._actor_params = list(self.policy.parameters())
+        self._critic_params = list(self.value.critic.parameters())
+        self.gae = GAE(gamma=cfg["gae"]["gamma"], lmbda=cfg["gae"]["lmbda"], value_network=self.value,
+                       average_gae=False)
+        self.optim = torch.optim.Adam(self.loss.parameters(), lr=oc["lr"])
+        self.lr = oc["lr"]
+        self.frames_per_batch = frames_per_batch
+        self.minibatch = min(oc["minibatch_size"], frames_per_batch)
+        self.rb = TensorDictReplayBuffer(storage=LazyTensorStorage(frames_per_batch, device=device),
+                                         sampler=SamplerWithoutReplacement(), batch_size=self.minibatch)
+
+    @property
+    def actor(self) -> torch.nn.Module:
+        """The bare network ``(hand, object, goal) -> (loc, scale)`` the collector's workers run."""
+        return self.policy.module[0].module
+
+    # ------------------------------------------------------------------ state
+    def state_dict(self) -> dict:
+        return dict(policy=self.policy.state_dict(), value=self.value.state_dict(), optim=self.optim.state_dict(),
+                    lr=self.lr)
+
+    def load_state_dict(self, state: dict) -> None:
+        self.policy.load_state_dict(state["policy"])
+        self.value.load_state_dict(state["value"])
+        self.optim.load_state_dict(state["optim"])
+        self.lr = state["lr"]
+        for g in self.optim.param_groups:
+            g["lr"] = self.lr
+
+    # ------------------------------------------------------------------ update
+    def update(self, data: TensorDict) -> dict:
+        """One PPO update on a collected batch ``data`` [..., T]: GAE on scaled rewards, return
+        statistics, then ``mini_epochs`` passes of minibatches through ClipPPOLoss (policy) and
+        the clipped critic loss in normalised units; actor and critic gradients are clipped
+        separately; the epochs end early at ``optim.kl_stop``. Rewrites ``data["next", "reward"]``
+        scaled. Returns the means of the loss module's diagnostics, ``kl``, ``lr``,
+        ``minibatch_steps`` and the return statistics."""
+        oc = self.cfg["optim"]
+        fitted_first = bool(self.norm.count < 1)
+        if fitted_first:  # first batch: fit the observation statistics before any update, and express
+            # the behaviour distribution under them (the initial action mean is ~0 either way)
+            self.norm.update({k: data[k] for k in OBS_KEYS})
+            with torch.no_grad():
+                obs = data.select(*OBS_KEYS).clone()
+                loc_scale = self.policy.module[0](obs)
+                data["loc"], data["scale"] = loc_scale["loc"], loc_scale["scale"]
+                data["action_log_prob"] = self.policy.get_dist(obs).log_prob(data["action"])
+        data["next", "reward"] = data["next", "reward"] * self.cfg["gae"]["reward_scale"]
+        with torch.no_grad():
+            self.gae(data)
+            vn = self.value.value_norm
+            vn.update(data["value_target"])
+            data["value_target_norm"] = vn.normalize(data["value_target"])
+            data["state_value_norm"] = vn.normalize(data["state_value"])  # old predictions, new units
+        flat = data.reshape(-1)
+        self.rb.empty()
+        self.rb.extend(flat)
+        n_mb = max(1, self.frames_per_batch // self.minibatch)
+        stats = {k: 0.0 for k in LOSS_KEYS}
+        stats.update(grad_norm_actor=0.0, grad_norm_critic=0.0)
+        count, stopped = 0, False
+        kl_stop = oc.get("kl_stop")
+        for _ in range(oc["mini_epochs"]):
+            if stopped:
+                break
+            for _ in range(n_mb):
+                klv = self._step(self.rb.sample(), stats)
+                count += 1
+                if kl_stop is not None and klv > kl_stop:  # the policy moved far enough for this batch
+                    stopped = True
+                    break
+        if not fitted_first:
+            self.norm.update({k: flat[k] for k in OBS_KEYS})
+        out = {k: v / count for k, v in stats.items()}
+        out["kl"] = out.pop("kl_approx")
+        out["lr"] = self.lr
+        out["minibatch_steps"] = count
+        out["value_mean"], out["value_std"] = float(vn.mean), float(vn.std())
+        return out
+
+    def _step(self, mb: TensorDict, stats: dict) -> float:
+        """One minibatch gradient step; adds its diagnostics to ``stats``; returns its KL."""
+        oc = self.cfg["optim"]
+        losses = self.loss(mb)
+        loss = losses["loss_objective"] + losses["loss_critic"]
+        if "loss_entropy" in losses.keys():
+            loss = loss + losses["loss_entropy"]
+        self.optim.zero_grad(set_to_none=True)
+        loss.backward()
+        ga = torch.nn.utils.clip_grad_norm_(self._actor_params, oc["max_grad_norm"])
+        gc = torch.nn.utils.clip_grad_norm_(self._critic_params, oc["max_grad_norm_critic"])
+        self.optim.step()
+        klv = float(losses["kl_approx"])
+        self._schedule_lr(klv)
+        for k in LOSS_KEYS:
+            if k in losses.keys():
+                stats[k] += float(losses[k].detach().float().mean())
+        stats["grad_norm_actor"] += float(ga)
+        stats["grad_norm_critic"] += float(gc)
+        return klv
+
+    def _schedule_lr(self, kl: float) -> None:
+        """``optim.schedule``: ``fixed``, or ``adaptive`` (rl_games): the rate shrinks by 1.5 when
+        the minibatch KL exceeds twice ``kl_threshold`` and grows by 1.5 below half of it, within
+        [``lr_min``, ``lr_max``] (a floor that keeps learning alive)."""
+        oc = self.cfg["optim"]
+        if oc["schedule"] == "fixed":
+            return
+        if kl > 2.0 * oc["kl_threshold"]:
+            self.lr = max(self.lr / 1.5, oc["lr_min"])
+        elif kl < 0.5 * oc["kl_threshold"]:
+            self.lr = min(self.lr * 1.5, oc["lr_max"])
+        for g in self.optim.param_groups:
+            g["lr"] = self.lr
