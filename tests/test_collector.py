@@ -77,3 +77,30 @@ def test_evaluation_in_the_workers_equals_one_process():
         c.close()
     whole = evaluation_shard(policy.module[0].module, shard=None, **kw)
     assert len(whole) == 4 and sorted(split, key=lambda t: t["object"]) == sorted(whole, key=lambda t: t["object"])
+
+
+@pytest.mark.slow
+def test_ray_env_actors_collect_what_local_workers_collect():
+    """The same run on a local Ray cluster (loopback): the env actors act with the main process's
+    current weights and give the batches of the local worker processes, bit for bit."""
+    ray = pytest.importorskip("ray")
+    from unicross.rl.ray_collector import RayCollector
+    ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False)
+    local = LeanCollector("UniCross-Grasp-v1", KW, num_envs=2, horizon=20, seed=5)
+    remote = RayCollector("UniCross-Grasp-v1", KW, num_envs=2, horizon=20, seed=5, address="local")
+    try:
+        policy, norm = _models(local)
+        local.set_actor(policy.module[0].module)
+        remote.set_actor(policy.module[0].module)
+        for _ in range(2):
+            a, b = local.collect(), remote.collect()
+            _check_batch(policy, b)
+            for k in ("action", "loc", ("next", "reward"), ("next", "hand"), ("next", "info", "reward_contact")):
+                assert torch.equal(a[k], b[k]), k
+            with torch.no_grad():  # an update between batches reaches both
+                policy.module[0].module.net.main[-1].bias.add_(0.3)
+                norm.update({k: a[k] for k in ("hand", "object", "goal")})
+    finally:
+        local.close()
+        remote.close()
+        ray.shutdown()

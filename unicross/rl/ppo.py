@@ -37,11 +37,15 @@ from unicross.rl.models import OBS_KEYS  # noqa: F401  (re-exported for benchmar
 CKPT_NAME = "checkpoint.pt"
 
 
-def resolve_num_envs(num_envs, backend: str) -> int:
-    """``env.num_envs``: null means one env per usable CPU core (CPU backend)."""
+def resolve_num_envs(num_envs, backend: str, ray_address: Optional[str] = None) -> int:
+    """``env.num_envs``: null means one env per usable CPU core (CPU backend; with Ray, per CPU
+    of the cluster)."""
     if num_envs is None:
         if backend != "physx_cpu":
             raise ValueError("env.num_envs must be set for the GPU backend (e.g. 4096)")
+        if ray_address:
+            import ray
+            return max(1, int(ray.cluster_resources().get("CPU", 1)))
         return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
     if int(num_envs) < 1:
         raise ValueError(f"env.num_envs must be >= 1, got {num_envs}")
@@ -146,13 +150,23 @@ class PPOTrainer:
         self.env_kwargs = env_kwargs_for(skill, axis, hand, cfg["env"])
         self.progress = progress
         self._seed_everything(cfg["seed"])
-        ec = cfg["env"]
-        num_envs = resolve_num_envs(ec["num_envs"], ec["backend"])
+        ec, ray_address = cfg["env"], cfg["collector"].get("ray_address")
+        if ray_address and ec["backend"] != "physx_cpu":
+            raise ValueError("collector.ray_address runs CPU env actors: it needs env.backend physx_cpu")
+        if ray_address:
+            from unicross.rl.ray_collector import connect
+            connect(ray_address)
+        num_envs = resolve_num_envs(ec["num_envs"], ec["backend"], ray_address)
         self.horizon = resolve_horizon(cfg["collector"], skill, num_envs)
         # envs of a resumed run start from new seeds (not a replay of the first iteration's starts)
-        start_iteration = int((self.ckpt or {}).get("iteration", 0))
-        self.collector = LeanCollector(self.env_id, self.env_kwargs, num_envs, self.horizon,
-                                       seed=cfg["seed"] + 1000 * start_iteration, backend=ec["backend"])
+        seed = cfg["seed"] + 1000 * int((self.ckpt or {}).get("iteration", 0))
+        if ray_address:
+            from unicross.rl.ray_collector import RayCollector
+            self.collector = RayCollector(self.env_id, self.env_kwargs, num_envs, self.horizon, seed=seed,
+                                          address=ray_address)
+        else:
+            self.collector = LeanCollector(self.env_id, self.env_kwargs, num_envs, self.horizon, seed=seed,
+                                           backend=ec["backend"])
         if ec["backend"] == "physx_cpu":  # workers and the update take turns: the update gets every core
             torch.set_num_threads(os.cpu_count() or 1)
         self.device = self.collector.device
