@@ -64,7 +64,7 @@ def training_rate(workers: int, iterations: int) -> dict:
         upd = sum(r["update_s"] for r in rows)
     finally:
         t.close()
-    return dict(workers=workers, frames_per_iteration=t.frames_per_batch, training_fps=round(fps, 1),
+    return dict(workers=workers, frames_per_iteration=t.collector.frames_per_batch, training_fps=round(fps, 1),
                 collect_share=round(coll / (coll + upd), 3), update_share=round(upd / (coll + upd), 3))
 
 
