@@ -343,10 +343,46 @@ class UniCrossEnv(BaseEnv):
         if self._seeded_reset and options.get("seed_generator", True):
             self._gen.manual_seed(int(self._episode_seed[0]))
         g = self._gen
-        mode = self.mode[env_idx]
-        skill = F.MODE_SKILL_ID.to(dev)[mode]
+        skill = F.MODE_SKILL_ID.to(dev)[self.mode[env_idx]]
+        hand_p, hand_q, obj_p, obj_q, fq = self._grasp_start(env_idx)
+        ft, mq = fq, None  # finger targets; recorded coupled-joint positions of a restored grasp
+        if self.grasps is not None:
+            hand_p, hand_q, obj_p, obj_q, fq, ft, mq = self._in_hand_start(env_idx, skill, hand_p, hand_q,
+                                                                          obj_p, obj_q, fq)
+        # ---- apply to the simulation
+        qpos = torch.zeros(b, spec.dof, device=dev)
+        qpos[:, 6:] = fq
+        art_q = self.articulation_qpos(qpos)
+        if mq is not None:  # coupled joints where they were, not where the coupling would put them
+            art_q[:, self._midx] = torch.where(mq[0], art_q[:, self._midx], mq[1])
+        self.agent.robot.set_qpos(art_q)
+        self.agent.robot.set_qvel(torch.zeros_like(art_q))
+        self.agent.robot.set_root_pose(Pose.create_from_pq(hand_p, hand_q))
+        self.obj.set_pose(Pose.create_from_pq(obj_p, obj_q))
+        # ---- task state
+        self.reset_task_state(env_idx, hand_p, hand_q, obj_p, obj_q, fq, skill == F.skill_id("relocate"))
+        cmd = torch.zeros(b, spec.dof, device=dev)
+        cmd[:, 6:] = ft
+        self.command[env_idx] = cmd
+        self.ever_dropped[env_idx] = False
+        self.perturb[env_idx] = 0
+        self.link_force[env_idx] = 0
+        dmax = self.cfg["disturbance"]["max_scale"]
+        if dmax > 0:  # constant force: random direction, magnitude U[0, dmax * m * g]
+            direction = torch.nn.functional.normalize(torch.randn(b, 3, generator=g, device=dev), dim=-1)
+            mag = torch.rand(b, generator=g, device=dev) * dmax * self.obj_mass[env_idx] * self._gravity
+            self.disturb[env_idx] = direction * mag[:, None]
+        self.obs_noise[env_idx] = self._draw_obs_noise(b)
+        for t in (self.obj_vel_h, self.obj_angvel_h, self.hand_vel, self.hand_angvel):
+            t[env_idx] = 0
+
+    def _grasp_start(self, env_idx):
+        """Grasp start: the object resting on the table (upright with probability 1/2 where it can
+        stand, random yaw and position), the hand top-down above it with the fingers spread
+        (theta0/theta1 of the hand spec), fingers along the long axis of an elongated object.
+        Returns world hand and object poses and finger joint positions."""
+        dev, spec, g, b = self.device, self.hand_spec, self._gen, len(env_idx)
         cat = self.obj_category[env_idx]
-        # ---- grasp start: object resting on the table, hand top-down, fingers spread (theta0/theta1)
         upright = (torch.rand(b, generator=g, device=dev) < 0.5) & self.obj_can_stand[env_idx]
         h = torch.where(upright, self.obj_rest_height[env_idx, 1], self.obj_rest_height[env_idx, 0])
         yaw = torch.rand(b, generator=g, device=dev) * 2 * math.pi
@@ -369,54 +405,50 @@ class UniCrossEnv(BaseEnv):
         hand_p_grasp = obj_p_table.clone()
         hand_p_grasp[:, 2] = 2 * h + self.cfg["grasp"]["hover"]
         init_pose = torch.stack([torch.tensor(spec.init_finger_qpos(c), device=dev) for c in ("wrappable", "elongated")])
-        fq_grasp = init_pose[cat]
-        # ---- in-hand start (relocate / rotate / translate): a grasp state from the dataset
-        hand_p, hand_q, obj_p, obj_q = hand_p_grasp, hand_q_grasp, obj_p_table, obj_q_table
-        fq, ft = fq_grasp, fq_grasp
-        mq = None  # recorded coupled-joint positions of a restored grasp
-        if self.grasps is not None:
-            gs = self.grasps.sample(self.obj_index[env_idx], self.object_names, g)
-            random_q = _random_quaternion(b, g, dev)
-            if self.cfg["in_hand_orientation"] == "palm_up":  # palm normal (+x_h) up, random yaw
-                psi = torch.rand(b, generator=g, device=dev) * 2 * math.pi
-                xu = torch.tensor([0.0, 0.0, 1.0], device=dev).expand(b, 3)
-                zu = torch.stack([torch.cos(psi), torch.sin(psi), torch.zeros_like(psi)], -1)
-                random_q = quat_from_matrix(torch.stack([xu, torch.cross(zu, xu, dim=-1), zu], dim=-1))
-            world_q = torch.where((skill == F.skill_id("relocate"))[:, None], gs["wrist_pose"][:, 3:], random_q)
-            world_p = gs["wrist_pose"][:, :3].clone()
-            inhand_h = self.cfg["in_hand_start_height"]
-            world_p = torch.where((skill == F.skill_id("relocate"))[:, None], world_p,
-                                  torch.tensor([0.0, 0.0, inhand_h], device=dev).expand(b, 3))
-            op, oq = pose_mul(world_p, world_q, gs["object_pose_hand"][:, :3], gs["object_pose_hand"][:, 3:])
-            is_grasp = (skill == F.skill_id("grasp"))[:, None]
-            hand_p = torch.where(is_grasp, hand_p, world_p)
-            hand_q = torch.where(is_grasp, hand_q, world_q)
-            obj_p = torch.where(is_grasp, obj_p, op)
-            obj_q = torch.where(is_grasp, obj_q, oq)
-            fq = torch.where(is_grasp, fq, gs["finger_qpos"])
-            ft = torch.where(is_grasp, ft, gs["finger_target"])
-            if "mimic_qpos" in gs.keys() and gs["mimic_qpos"].shape[-1] == len(self._midx) > 0:
-                mq = (is_grasp, gs["mimic_qpos"])
-        # ---- apply to the simulation
-        qpos = torch.zeros(b, spec.dof, device=dev)
-        qpos[:, 6:] = fq
-        art_q = self.articulation_qpos(qpos)
-        if mq is not None:  # coupled joints where they were, not where the coupling would put them
-            art_q[:, self._midx] = torch.where(mq[0], art_q[:, self._midx], mq[1])
-        self.agent.robot.set_qpos(art_q)
-        self.agent.robot.set_qvel(torch.zeros_like(art_q))
-        self.agent.robot.set_root_pose(Pose.create_from_pq(hand_p, hand_q))
-        self.obj.set_pose(Pose.create_from_pq(obj_p, obj_q))
-        # ---- task state
+        return hand_p_grasp, hand_q_grasp, obj_p_table, obj_q_table, init_pose[cat]
+
+    def _in_hand_start(self, env_idx, skill, hand_p, hand_q, obj_p, obj_q, fq):
+        """In-hand start (relocate / rotate / translate; grasp envs keep the given start): a grasp
+        state from the dataset, with the wrist where it was grasped for relocate and at
+        ``in_hand_start_height`` in a random (or palm-up) orientation for rotate and translate.
+        Returns hand and object poses, finger positions and targets, and the recorded coupled-joint
+        positions (``(is_grasp, mimic_qpos)`` or None)."""
+        dev, g, b = self.device, self._gen, len(env_idx)
+        gs = self.grasps.sample(self.obj_index[env_idx], self.object_names, g)
+        random_q = _random_quaternion(b, g, dev)
+        if self.cfg["in_hand_orientation"] == "palm_up":  # palm normal (+x_h) up, random yaw
+            psi = torch.rand(b, generator=g, device=dev) * 2 * math.pi
+            xu = torch.tensor([0.0, 0.0, 1.0], device=dev).expand(b, 3)
+            zu = torch.stack([torch.cos(psi), torch.sin(psi), torch.zeros_like(psi)], -1)
+            random_q = quat_from_matrix(torch.stack([xu, torch.cross(zu, xu, dim=-1), zu], dim=-1))
+        is_reloc = (skill == F.skill_id("relocate"))[:, None]
+        world_q = torch.where(is_reloc, gs["wrist_pose"][:, 3:], random_q)
+        inhand_p = torch.tensor([0.0, 0.0, self.cfg["in_hand_start_height"]], device=dev).expand(b, 3)
+        world_p = torch.where(is_reloc, gs["wrist_pose"][:, :3], inhand_p)
+        op, oq = pose_mul(world_p, world_q, gs["object_pose_hand"][:, :3], gs["object_pose_hand"][:, 3:])
+        is_grasp = (skill == F.skill_id("grasp"))[:, None]
+        mq = None
+        if "mimic_qpos" in gs.keys() and gs["mimic_qpos"].shape[-1] == len(self._midx) > 0:
+            mq = (is_grasp, gs["mimic_qpos"])
+        return (torch.where(is_grasp, hand_p, world_p), torch.where(is_grasp, hand_q, world_q),
+                torch.where(is_grasp, obj_p, op), torch.where(is_grasp, obj_q, oq),
+                torch.where(is_grasp, fq, gs["finger_qpos"]), torch.where(is_grasp, fq, gs["finger_target"]), mq)
+
+    def reset_task_state(self, env_idx, hand_p, hand_q, obj_p, obj_q, finger_q0, relocate_goal):
+        """The task state at the start of an episode or of a chain phase, for envs ``env_idx``, from
+        the world poses of the hand (the new root frame) and the object: every relational pose and
+        target at its start value, the relocation goal drawn from the paper's ranges around the
+        object where ``relocate_goal`` [B] is set (elsewhere the start pose), accumulated motion and
+        lift cleared, the finger reference pose ``finger_q0``. The one place both
+        ``_initialize_episode`` and the chain's phase switch start a mode from."""
+        b, dev, g = len(env_idx), self.device, self._gen
         self.root_p[env_idx], self.root_q[env_idx] = hand_p, hand_q
         xo, qo = relative_pose(hand_p, hand_q, obj_p, obj_q)
         ident = torch.zeros(b, 4, device=dev)
         ident[:, 0] = 1
         init = F.Relational(x_oh=xo, q_oh=qo, x_or=xo, q_or=qo, x_hr=torch.zeros_like(xo), q_hr=ident)
-        self.init_rel.assign(init, env_idx)
-        self.targets.assign(init, env_idx)
-        self.prev_rel.assign(init, env_idx)
-        self.cur_rel.assign(init, env_idx)
+        for rel in (self.init_rel, self.targets, self.prev_rel, self.cur_rel):
+            rel.assign(init, env_idx)
         # relocate: final object pose = start + world offsets (x, y, z; roll, pitch, yaw)
         rt = self.cfg["relocate_target"]
         off = torch.rand(b, 3, generator=g, device=dev)
@@ -425,28 +457,13 @@ class UniCrossEnv(BaseEnv):
         rpy = (torch.rand(b, 3, generator=g, device=dev) * 2 - 1) * rt["rpy"]
         fp, fqw = obj_p + off, quat_positive(quat_mul(quat_from_euler_xyz(rpy), obj_q))
         fx, fqr = relative_pose(hand_p, hand_q, fp, fqw)
-        is_reloc = (skill == F.skill_id("relocate"))[:, None]
-        self.final_x_or[env_idx] = torch.where(is_reloc, fx, xo)
-        self.final_q_or[env_idx] = torch.where(is_reloc, fqr, qo)
-        cmd = torch.zeros(b, spec.dof, device=dev)
-        cmd[:, 6:] = ft
-        self.command[env_idx] = cmd
-        self.finger_q0[env_idx] = fq
+        self.final_x_or[env_idx] = torch.where(relocate_goal[:, None], fx, xo)
+        self.final_q_or[env_idx] = torch.where(relocate_goal[:, None], fqr, qo)
+        self.finger_q0[env_idx] = finger_q0
         self.rot_acc[env_idx] = 0
         self.trans_acc[env_idx] = 0
-        self.ever_dropped[env_idx] = False
         self.obj_z0[env_idx] = obj_p[:, 2]
         self.lift[env_idx] = 0
-        self.perturb[env_idx] = 0
-        self.link_force[env_idx] = 0
-        dmax = self.cfg["disturbance"]["max_scale"]
-        if dmax > 0:  # constant force: random direction, magnitude U[0, dmax * m * g]
-            direction = torch.nn.functional.normalize(torch.randn(b, 3, generator=g, device=dev), dim=-1)
-            mag = torch.rand(b, generator=g, device=dev) * dmax * self.obj_mass[env_idx] * self._gravity
-            self.disturb[env_idx] = direction * mag[:, None]
-        self.obs_noise[env_idx] = self._draw_obs_noise(b)
-        for t in (self.obj_vel_h, self.obj_angvel_h, self.hand_vel, self.hand_angvel):
-            t[env_idx] = 0
         self._pending[env_idx] = True
 
     def _draw_obs_noise(self, n: int) -> torch.Tensor:

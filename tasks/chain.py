@@ -20,7 +20,7 @@ from unicross.tasks.registration import register_task
 from mani_skill.utils.structs.pose import Pose
 
 from unicross import formulation as F
-from unicross.geometry import quat_apply, quat_from_euler_xyz, quat_inv, quat_mul, quat_positive, relative_pose
+from unicross.geometry import quat_apply, quat_inv
 from unicross.objects import get_object_set, resolve_objects
 from unicross.registry import SKILLS, skill_of_mode
 from unicross.tasks.base import UniCrossEnv
@@ -119,24 +119,8 @@ class ChainEnv(UniCrossEnv):
         # task state of the new phase
         self.phase = k
         self.mode[:] = F.MODES.index(self.sequence[k])
-        self.root_p, self.root_q = hand_p.clone(), hand_q.clone()
-        xo, qo = relative_pose(hand_p, hand_q, obj_p, obj_q)
-        ident = torch.zeros(n, 4, device=dev)
-        ident[:, 0] = 1
-        init = F.Relational(x_oh=xo, q_oh=qo, x_or=xo, q_or=qo, x_hr=torch.zeros_like(xo), q_hr=ident)
-        self.init_rel, self.targets, self.prev_rel, self.cur_rel = init.clone(), init.clone(), init.clone(), init.clone()
-        rt, g = self.cfg["relocate_target"], self._gen
-        off = torch.rand(n, 3, generator=g, device=dev)
-        off = torch.stack([(off[:, 0] * 2 - 1) * rt["xy"], (off[:, 1] * 2 - 1) * rt["xy"],
-                           rt["z"][0] + off[:, 2] * (rt["z"][1] - rt["z"][0])], -1)
-        rpy = (torch.rand(n, 3, generator=g, device=dev) * 2 - 1) * rt["rpy"]
-        fp, fq = obj_p + off, quat_positive(quat_mul(quat_from_euler_xyz(rpy), obj_q))
-        self.final_x_or, self.final_q_or = relative_pose(hand_p, hand_q, fp, fq)
-        self.finger_q0 = self.agent.robot.get_qpos()[:, self._qidx[6:]].clone()
-        self.rot_acc.zero_()
-        self.trans_acc.zero_()
-        self.obj_z0 = obj_p[:, 2].clone()
-        self.lift.zero_()
+        every = torch.ones(n, dtype=torch.bool, device=dev)
+        self.reset_task_state(torch.arange(n, device=dev), hand_p, hand_q, obj_p, obj_q,
+                              robot.get_qpos()[:, self._qidx[6:]].clone(), relocate_goal=every)
         self.static_skill = F.mode_skill(self.sequence[k])
-        self._pending = torch.ones_like(self._pending)
         self._stepped = False
