@@ -644,76 +644,109 @@ class UniCrossEnv(BaseEnv):
         m = self._measure(pos, quat, force, qpos, qvel)
         cur = F.relational_poses(self.root_p, self.root_q, m["hand_p"], m["hand_q"], m["obj_p"], m["obj_q"])
         pend = self._pending
-        # velocities and accumulated motion over the last control step
+        skill = F.MODE_SKILL_ID.to(self.device)[self.mode]
+        axis_prev = self.axis
+        goal_err_prev, goal_err = self._goal_errors(cur)
+        self._advance_motion(cur, pend, skill, axis_prev)
+        # reward compares against the targets the last action aimed at; Free targets = current
+        reward_targets = F.with_free_as_current(self.mode, self.targets, cur)
+        drop = self._drop(m["link_distance"], skill, elapsed_steps)
+        self._advance_targets(cur, pend)
+        success, contact, lifted, pos_err, rot_err = self._success(m, skill)
+        force_c = m["force"].clamp(max=self.cfg["force_clip"])
+        # motion along the axis the last action was asked to follow
+        is_rot = skill == F.skill_id("rotate")
+        speed = torch.where(is_rot, (self.obj_angvel_h * axis_prev).sum(-1), (self.obj_vel_h * axis_prev).sum(-1))
+        meas = dict(link_distance=m["link_distance"], contact=contact, force_clipped=force_c, speed_along_axis=speed,
+                    speed_cap=self._speed_cap[self.mode], relational=cur, reward_targets=reward_targets,
+                    finger_qpos=m["qpos"][:, 6:], finger_qpos0=self.finger_q0, hand_lin_vel=self.hand_vel,
+                    hand_ang_vel=self.hand_angvel, finger_torque=m["finger_torque"], drop=drop, success=success,
+                    goal_err_prev=goal_err_prev, goal_err=goal_err)
+        terms = self.rewards(self.mode, meas)
+        self._observation_parts(m, cur, contact, force_c)
+        info = dict(success=success, fail=drop, drop=drop, ever_dropped=self.ever_dropped.clone(),
+                    lifted=lifted, relocate_pos_err=pos_err, relocate_rot_err=rot_err,
+                    rotation=self.rot_acc.clone(), translation=self.trans_acc.clone(),
+                    num_contacts=contact.sum(-1), mode=self.mode.clone())
+        info.update({f"reward_{k}": v for k, v in terms.items()})
+        return info
+
+    def _goal_errors(self, cur: F.Relational):
+        """The object's position (m) and angle (rad) error to its final root-frame pose before and
+        after the step ([N, 2] each; ``r_progress``)."""
+        prev = self.prev_rel
+        before = torch.stack([torch.linalg.norm(prev.x_or - self.final_x_or, dim=-1),
+                              quat_angle(prev.q_or, self.final_q_or)], dim=-1)
+        after = torch.stack([torch.linalg.norm(cur.x_or - self.final_x_or, dim=-1),
+                             quat_angle(cur.q_or, self.final_q_or)], dim=-1)
+        return before, after
+
+    def _advance_motion(self, cur: F.Relational, pend, skill, axis_prev):
+        """Velocities over the last control step (object in the hand frame, hand in the root frame)
+        and the rotation / translation accumulated along the mode's axis, once per control step."""
         dt = self.control_dt
         (xp, qp), (xc, qc) = self.prev_rel.poses(), cur.poses()
-        # the object's error to its final root-frame pose before and after the step (r_progress)
-        goal_err_prev = torch.stack([torch.linalg.norm(self.prev_rel.x_or - self.final_x_or, dim=-1),
-                                     quat_angle(self.prev_rel.q_or, self.final_q_or)], dim=-1)
-        goal_err = torch.stack([torch.linalg.norm(cur.x_or - self.final_x_or, dim=-1),
-                                quat_angle(cur.q_or, self.final_q_or)], dim=-1)
-        vel, angvel = F.finite_velocity(xp[:, ::2], qp[:, ::2], xc[:, ::2], qc[:, ::2], dt)  # object in hand, hand in root
+        vel, angvel = F.finite_velocity(xp[:, ::2], qp[:, ::2], xc[:, ::2], qc[:, ::2], dt)
         v, w, hv, hw = vel[:, 0], angvel[:, 0], vel[:, 1], angvel[:, 1]
         p1 = pend[:, None]
         self.obj_vel_h = torch.where(p1, v, self.obj_vel_h)
         self.obj_angvel_h = torch.where(p1, w, self.obj_angvel_h)
         self.hand_vel = torch.where(p1, hv, self.hand_vel)
         self.hand_angvel = torch.where(p1, hw, self.hand_angvel)
-        skill = F.MODE_SKILL_ID.to(self.device)[self.mode]
         is_rot = skill == F.skill_id("rotate")
         is_trans = skill == F.skill_id("translate")
-        axis_prev = self.axis
         self.rot_acc = self.rot_acc + (pend & is_rot).float() * (w * axis_prev).sum(-1) * dt
         self.trans_acc = self.trans_acc + (pend & is_trans).float() * (v * axis_prev).sum(-1) * dt
-        # reward compares against the targets the last action aimed at; Free targets = current
-        reward_targets = F.with_free_as_current(self.mode, self.targets, cur)
-        # drop and success (DESIGN §6)
-        dist = m["link_distance"]
+
+    def _drop(self, dist, skill, elapsed_steps):
+        """Drop (DESIGN §6): every link farther than ``drop_threshold`` from the object; a grasp can
+        only drop what it lifted (before the lift phase the object rests on the table)."""
         drop = dist.min(dim=-1).values > self.cfg["drop_threshold"]
-        # a grasp can only drop what it lifted: before the lift phase the object rests on the table
         lift_after = self.cfg["grasp"]["lift_after"]
         grasp_lifting = (elapsed_steps >= lift_after) if lift_after is not None else torch.zeros_like(drop)
         drop = drop & ((skill != F.skill_id("grasp")) | grasp_lifting)
         self.ever_dropped = self.ever_dropped | drop
-        # advance the targets; after a drop they hold still: a lost object's pose no longer defines
-        # where the hand should go (Tracked hand targets would chase it; measured: the wrist
-        # reference jumped and slammed the hand at 11 m/s in a relocate episode without termination)
+        return drop
+
+    def _advance_targets(self, cur: F.Relational, pend):
+        """The next targets and task axis, once per control step. After a drop they hold still: a
+        lost object's pose no longer defines where the hand should go (Tracked hand targets would
+        chase it; measured: the wrist reference jumped and slammed the hand at 11 m/s in a relocate
+        episode without termination)."""
         axis = F.task_axis(self.mode, cur, self.final_x_or)
         init = self.init_rel.clone()
         init.x_or = init.x_or + self.lift
         new_t = F.update_targets(self.mode, cur, init, self.final_x_or, self.final_q_or, axis, self.motion,
                                  skill=self.static_skill)
         self.targets = new_t.where(pend & ~self.ever_dropped, self.targets)
-        self.axis = torch.where(p1, axis, self.axis)
+        self.axis = torch.where(pend[:, None], axis, self.axis)
         self.prev_rel = cur.where(pend, self.prev_rel)
         self.cur_rel = cur
         self._pending = torch.zeros_like(pend)
-        # success (DESIGN §6)
+
+    def _success(self, m: Dict[str, torch.Tensor], skill):
+        """Success of each env's skill (DESIGN §6), never after a drop: grasp lifted with >= 2
+        contacts; relocate within the position/angle thresholds of the final pose; rotate/translate
+        accumulated past their thresholds. Returns (success, contact, lifted, pos_err, rot_err)."""
         contact = m["force"] > self.cfg["contact_force_threshold"]
         lifted = (m["obj_p"][:, 2] - self.obj_z0) > self.cfg["grasp"]["lift_success"]
         fx, fq = pose_mul(self.root_p, self.root_q, self.final_x_or, self.final_q_or)
         pos_err = torch.linalg.norm(m["obj_p"] - fx, dim=-1)
         rot_err = quat_angle(m["obj_q"], fq)
         sc = self.cfg["success"]
-        ok = ~self.ever_dropped
         success_by_skill = torch.stack([
             lifted & (contact.sum(-1) >= 2),
             (pos_err < sc["relocate_pos"]) & (rot_err < sc["relocate_rot"]),
             self.rot_acc > sc["rotate_angle"],
             self.trans_acc > sc["translate_dist"],
         ], dim=-1)
-        success = success_by_skill.gather(1, skill[:, None])[:, 0] & ok
-        # measurements for observation and reward
-        force_c = m["force"].clamp(max=self.cfg["force_clip"])
-        # motion along the axis the last action was asked to follow
-        speed = torch.where(is_rot, (self.obj_angvel_h * axis_prev).sum(-1), (self.obj_vel_h * axis_prev).sum(-1))
-        meas = dict(link_distance=dist, contact=contact, force_clipped=force_c, speed_along_axis=speed,
-                    speed_cap=self._speed_cap[self.mode], relational=cur, reward_targets=reward_targets,
-                    finger_qpos=m["qpos"][:, 6:], finger_qpos0=self.finger_q0, hand_lin_vel=self.hand_vel,
-                    hand_ang_vel=self.hand_angvel, finger_torque=m["finger_torque"], drop=drop, success=success,
-                    goal_err_prev=goal_err_prev, goal_err=goal_err)
-        terms = self.rewards(self.mode, meas)
-        # observation parts (the noise on joint readings is added when observed: it is drawn after this math)
+        success = success_by_skill.gather(1, skill[:, None])[:, 0] & ~self.ever_dropped
+        return success, contact, lifted, pos_err, rot_err
+
+    def _observation_parts(self, m: Dict[str, torch.Tensor], cur: F.Relational, contact, force_c):
+        """The observation's parts with the ablations applied (``_obs_parts``; the noise on joint
+        readings is added when observed, since it is drawn after this math) and the measurements as
+        measured (``_measured``: recordings, renders)."""
         ab = self.cfg["ablation"]
         obs_contact, obs_force = contact.float(), force_c
         obs_vec = m["link_vec"].reshape(self.num_envs, -1)
@@ -722,15 +755,8 @@ class UniCrossEnv(BaseEnv):
         if ab["no_distance"]:
             obs_vec = torch.zeros_like(obs_vec)
         goal = F.goal_features(self.mode, self.axis, cur, self.targets, zero_target=ab["no_target_obs"])
-        # measurements as observed (ablations applied) and as measured (recordings, renders)
         self._obs_parts = dict(qpos=m["qpos"], contact=obs_contact, force=obs_force, distance=obs_vec, goal=goal)
         self._measured = dict(qpos=m["qpos"], contact=contact, force=force_c, vec=m["link_vec"])
-        info = dict(success=success, fail=drop, drop=drop, ever_dropped=self.ever_dropped.clone(),
-                    lifted=lifted, relocate_pos_err=pos_err, relocate_rot_err=rot_err,
-                    rotation=self.rot_acc.clone(), translation=self.trans_acc.clone(),
-                    num_contacts=contact.sum(-1), mode=self.mode.clone())
-        info.update({f"reward_{k}": v for k, v in terms.items()})
-        return info
 
     # ------------------------------------------------------------------ observation
     def _get_obs_agent(self):
