@@ -115,3 +115,14 @@ def test_cli_eval_gives_the_same_trials_on_any_number_of_workers(tmp_path, grasp
                     "--out", str(path)]) == 0
         out[w] = json.loads(path.read_text())["trials"]
     assert len(out[1]["translate"]) == 8 and out[1] == out[2]
+
+
+def test_eval_ablation_flags_checked_before_simulation(tmp_path, capsys):
+    from unicross.cli import main
+    out = str(tmp_path / "e.json")
+    assert main(["eval", "--policy", "zero", "--protocol", "relocate", "--ablation", "no_such", "--out", out]) == 2
+    assert "unknown ablation" in capsys.readouterr().err
+    # a checkpoint runs with the switches it was trained with
+    assert main(["eval", "--policy", "allegro/relocate", "--protocol", "relocate", "--ablation", "no_target_action",
+                 "--out", out]) == 2
+    assert "trained with ablation none" in capsys.readouterr().err

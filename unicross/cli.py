@@ -247,17 +247,27 @@ def _cmd_eval(args) -> int:
         raise ValueError(f"unknown protocol(s) {bad}; valid: {list(E.PROTOCOLS)} or 'all'")
     objs = get_object_set(args.objects, limit=args.limit)
     _, desc = E.resolve_policy(args.policy, args.hand, seed=args.seed)  # checks the checkpoint before simulating
+    ablation = desc.get("ablation")
+    if args.ablation:
+        bad = [f for f in args.ablation if f not in ABLATIONS]
+        if bad:
+            raise ValueError(f"unknown ablation {bad}; valid: {list(ABLATIONS)}")
+        trained = sorted(k for k, v in (ablation or {}).items() if v)
+        if desc["kind"] == "checkpoint" and trained != sorted(set(args.ablation)):
+            raise ValueError(f"checkpoint {args.policy} was trained with ablation {trained or 'none'}; "
+                             f"it is evaluated with the switches it was trained with (drop --ablation)")
+        ablation = {f: True for f in args.ablation}
     label = args.label or Path(args.policy).stem
     result = dict(label=label, policy=desc, objects=args.objects, limit=args.limit, hand=args.hand,
                   trials_per_object=args.trials_per_object, seed=args.seed, disturb=args.disturb,
-                  original=args.original, randomize=args.randomize, summaries={}, trials={})
+                  original=args.original, randomize=args.randomize, ablation=ablation or {}, summaries={}, trials={})
     for p in protocols:
         trials = E.run_protocol_workers(p, args.policy, objs, hand=args.hand, workers=args.workers, seed=args.seed,
                                         trials_per_object=args.trials_per_object, disturb=args.disturb,
                                         randomize=args.randomize, grasp_dataset=args.grasps, original=args.original,
                                         videos=args.videos,
                                         video_dir=Path(args.out).parent / (Path(args.out).stem + "_videos"),
-                                        ablation=desc.get("ablation"))
+                                        ablation=ablation)
         result["trials"][p] = trials
         result["summaries"][p] = E.summarize(p, trials)
     out = Path(args.out)
@@ -393,6 +403,9 @@ def main(argv=None) -> int:
     s.add_argument("--seed", type=int, default=0)
     s.add_argument("--label", default=None, help="row label in tables (default: the policy name)")
     s.add_argument("--videos", type=int, default=0, help="record and render the first K trials of each protocol")
+    s.add_argument("--ablation", action="append", metavar="FLAG",
+                   help="evaluate zero/scripted policies under one of the paper's ablations (repeatable; a "
+                        "checkpoint always runs with the switches it was trained with): " + ", ".join(ABLATIONS))
     s.add_argument("--workers", type=int, default=1,
                    help="processes to split the objects over (same trials for any number; one env per process)")
     s.add_argument("--out", required=True)
