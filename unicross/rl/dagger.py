@@ -132,6 +132,7 @@ class DAggerTrainer:
         return dict(policy=self.student.state_dict(), optim=self.optim.state_dict(), epoch=self.epoch,
                     frames=self.frames, config=self.cfg, experts_dir=self.experts_dir, skill="multi", axis=None,
                     hand=self.teachers.hand, obs_dims=self.dims, n_act=self.n_act, modes=list(F.MODES),
+                    distilled_modes=list(self.teachers.modes),
                     git_commit=git_commit(),
                     env_kwargs=self.env_kwargs,
                     rng=dict(torch=torch.get_rng_state(), numpy=np.random.get_state(), python=random.getstate()))

@@ -10,8 +10,8 @@ from unicross.rl.models import make_models
 
 
 SHIPPED_DIR = Path(__file__).resolve().parent.parent / "checkpoints"
-SHIPPED_KEYS = ("policy", "obs_dims", "n_act", "modes", "config", "skill", "axis", "hand", "env_id", "env_kwargs",
-                "iteration", "frames", "git_commit", "commits")
+SHIPPED_KEYS = ("policy", "obs_dims", "n_act", "modes", "distilled_modes", "config", "skill", "axis", "hand", "env_id",
+                "env_kwargs", "iteration", "epoch", "frames", "git_commit", "commits")
 
 
 def resolve_checkpoint(spec) -> Path:
