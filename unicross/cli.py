@@ -11,6 +11,7 @@
     unicross chain --policy P --sequence grasp,relocate,rotate:x+   one continuous long-horizon episode
     unicross eval --policy P ...          the paper's evaluation protocols -> JSON + table
     unicross report FILES...              assemble eval results into the paper's tables
+    unicross report --paper               evaluate the shipped checkpoints -> docs/results.md (paper layout)
     unicross render TRAJ --out V.mp4      draw a trajectory file (no GPU needed)
 
 Bad input (unknown skill/axis/hand/object set, missing files) fails before any simulation.
@@ -282,6 +283,10 @@ def _cmd_eval(args) -> int:
 
 def _cmd_report(args) -> int:
     from unicross import evaluation as E
+    if args.paper:
+        return _cmd_report_paper(args)
+    if not args.files:
+        raise ValueError("report needs eval JSON files, or --paper to evaluate the shipped checkpoints")
     rows: dict = {}
     for f in args.files:
         r = json.loads(Path(f).read_text())
@@ -295,6 +300,26 @@ def _cmd_report(args) -> int:
     print(table)
     if args.out:
         Path(args.out).write_text(table + "\n")
+    return 0
+
+
+def _cmd_report_paper(args) -> int:
+    from unicross.report import paper_report
+    if args.files:
+        raise ValueError("report --paper evaluates the shipped checkpoints; it takes no eval JSON files")
+    if args.trials_per_object < 1 or args.limit < 0 or args.workers < 1:
+        raise ValueError("--trials-per-object and --workers must be >= 1, --limit >= 0 (0: every object)")
+    out = Path(args.out or "docs/results.md")
+    out.parent.mkdir(parents=True, exist_ok=True)
+    if out.is_dir():
+        raise ValueError(f"--out {out} is a directory; give a .md file")
+    with open(out, "a"):  # writable, checked before any simulation
+        pass
+    argv = ["report", "--paper", "--hand", args.hand, "--limit", str(args.limit), "--trials-per-object",
+            str(args.trials_per_object), "--workers", str(args.workers), "--seed", str(args.seed), "--out", str(out)]
+    paper_report(str(out), argv, hand=args.hand, limit=args.limit or None,
+                 trials=args.trials_per_object, workers=args.workers, seed=args.seed)
+    print(f"wrote {out}")
     return 0
 
 
@@ -410,10 +435,18 @@ def main(argv=None) -> int:
                    help="processes to split the objects over (same trials for any number; one env per process)")
     s.add_argument("--out", required=True)
     s.set_defaults(fn=_cmd_eval)
-    s = sub.add_parser("report", help="assemble eval JSON files into the paper's table layout")
-    s.add_argument("files", nargs="+")
+    s = sub.add_parser("report", help="assemble eval JSON files into the paper's table layout; --paper: evaluate "
+                                      "the shipped checkpoints and write the paper's tables (docs/results.md)")
+    s.add_argument("files", nargs="*")
     s.add_argument("--title", default=None)
-    s.add_argument("--out", default=None)
+    s.add_argument("--out", default=None, help="markdown file (--paper: default docs/results.md)")
+    s.add_argument("--paper", action="store_true",
+                   help="evaluate every shipped checkpoint of --hand with the paper's protocols and write the tables")
+    s.add_argument("--hand", default="allegro")
+    s.add_argument("--limit", type=int, default=10, help="--paper: first N objects per (category, shape) group (0: all, the paper's full sets)")
+    s.add_argument("--trials-per-object", type=int, default=3, help="--paper: trials per object and axis")
+    s.add_argument("--workers", type=int, default=1, help="--paper: processes per evaluation")
+    s.add_argument("--seed", type=int, default=0)
     s.set_defaults(fn=_cmd_report)
     s = sub.add_parser("render", help="render a trajectory file to .mp4/.gif/.png (CPU: pyrender+EGL; GPU: SAPIEN)")
     s.add_argument("trajectory")

@@ -1,0 +1,50 @@
+"""``unicross report --paper`` end to end on one object per group and one trial per protocol."""
+import pytest
+
+from unicross.cli import main
+
+
+def test_report_paper_one_trial(tmp_path):
+    from unicross import evaluation as E
+    from unicross.objects import get_object_set
+    from unicross.report import _cell, shipped
+    out = tmp_path / "results.md"
+    assert main(["report", "--paper", "--limit", "1", "--trials-per-object", "1", "--out", str(out)]) == 0
+    text = out.read_text()
+    assert text.splitlines()[2].startswith("Command: `unicross report")
+    for title in ("Experts, held-out test objects", "Student, held-out test objects", "Unseen objects",
+                  "Disturbances", "Baselines", "Long horizon"):
+        assert f"## {title}" in text
+    n_test = len(get_object_set("test", limit=1))
+    ships = shipped("allegro")
+    for mode in ("grasp", "relocate"):
+        if mode in ships:  # one trial per test object
+            assert f"| {mode} | allegro/{mode} | " in text and f"(n={n_test})" in text
+    for mode in ("rotate_x+", "translate_z-"):
+        if mode not in ships:
+            assert f"| {mode} | expert not shipped | -- |" in text
+    # a cell is the evaluation itself: the zero-action relocation row equals an independent run
+    trials = E.run_protocol("relocate", E.zero_policy, get_object_set("test", limit=1), trials_per_object=1,
+                            seed=0, progress=False)
+    assert f"| relocate | zero | {_cell(E.summarize('relocate', trials), 'relocate')} |" in text
+
+
+@pytest.mark.parametrize("argv,msg", [
+    (["report", "--paper", "--trials-per-object", "0"], ">= 1"),
+    (["report", "--paper", "some.json"], "takes no eval JSON files"),
+    (["report"], "--paper"),
+])
+def test_report_bad_input_fails_before_simulation(argv, msg, capsys):
+    assert main(argv) == 2
+    assert msg in capsys.readouterr().err
+
+
+def test_report_out_directory_refused(tmp_path, capsys):
+    assert main(["report", "--paper", "--out", str(tmp_path)]) == 2
+    assert "is a directory" in capsys.readouterr().err
+
+
+def test_paper_values_format():
+    from unicross.report import _paper
+    assert _paper("Ours", "relocate") == "99.0 / 0.54 / 0.0134"
+    assert _paper("Experts", "grasp") == "99.0"

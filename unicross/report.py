@@ -1,0 +1,151 @@
+"""``unicross report --paper``: the paper's evaluation tables regenerated from the shipped checkpoints.
+
+Every cell is an evaluation run by this module (no number is copied from elsewhere) with its n and
+95% Wilson interval, and the paper's value beside it. Modes without a shipped expert, or a table
+that needs the student when none is shipped, are listed as not shipped rather than left out. The
+command that regenerates the file is printed at its top.
+"""
+from __future__ import annotations
+
+import shlex
+import time
+from pathlib import Path
+from typing import Callable, Dict, List, Optional
+
+from unicross import evaluation as E
+from unicross import formulation as F
+from unicross.objects import get_object_set
+from unicross.registry import mode_axis, skill_of_mode
+
+CHECKPOINTS = Path(__file__).parent / "checkpoints"
+
+# The paper's values (Tables "Comparison", "Generalization & Robustness", "Ablation", "Long-horizon"):
+# per skill (SR %, metric): relocate (SR, PE cm, AE rad), rotate (SR, Rot. rad), translate (SR, Trans. cm).
+PAPER = {
+    "Experts": dict(grasp=(99.0,), relocate=(99.1, 0.53, 0.0140), rotate=(99.1, 14.1), translate=(99.3, 20.5)),
+    "Ours": dict(grasp=(98.7,), relocate=(99.0, 0.54, 0.0134), rotate=(98.8, 13.6), translate=(99.1, 20.3)),
+    "Uns.": dict(grasp=(95.8,), relocate=(98.6, 0.50, 0.0152), rotate=(98.3, 14.5), translate=(96.0, 18.1)),
+    "Dis.": dict(grasp=(98.6,), relocate=(99.0, 0.55, 0.0136), rotate=(98.4, 13.7), translate=(97.6, 20.2)),
+    "Gen. (Base.)": dict(grasp=(97.1,), relocate=(92.8, 0.85, 0.0231), rotate=(62.7, 9.43), translate=(70.6, 5.81)),
+    "long": {"Gr. + Re. + Rot.": (99.7, 92.2, 95.1, 87.4), "Gr. + Re. + Trans.": (99.9, 98.3, 98.0, 96.3)},
+}
+
+
+def shipped(hand: str = "allegro") -> Dict[str, str]:
+    """Mode (or ``student``) -> ``<hand>/<name>`` of every checkpoint shipped for ``hand``."""
+    d = CHECKPOINTS / hand
+    names = list(F.MODES) + ["student"]
+    return {n: f"{hand}/{n}" for n in names if (d / f"{n}.pt").exists()}
+
+
+def _paper(setting: str, skill: str) -> str:
+    v = PAPER[setting].get(skill)
+    return "--" if v is None else " / ".join([f"{v[0]:.1f}"] + [f"{x:g}" for x in v[1:]])
+
+
+def _cell(s: dict, skill: str) -> str:
+    out = f"{s['sr']:.1f} [{s['ci95'][0]:.1f}-{s['ci95'][1]:.1f}] (n={s['n']})"
+    if skill == "relocate":
+        out += f", PE {s['pe_cm']:.2f} cm, AE {s['ae_rad']:.4f} rad"
+    elif skill == "rotate":
+        out += f", Rot. {s['rot_rad']:.2f} rad"
+    elif skill == "translate":
+        out += f", Trans. {s['trans_cm']:.1f} cm"
+    return out
+
+
+class PaperReport:
+    """Runs the evaluations of the report (``limit`` objects per group x ``trials`` per object and
+    axis, ``workers`` processes) and assembles the markdown."""
+
+    def __init__(self, hand: str = "allegro", limit: Optional[int] = 10, trials: int = 3, workers: int = 1,
+                 seed: int = 0, log: Callable[[str], None] = print):
+        self.hand, self.limit, self.trials, self.workers, self.seed, self.log = hand, limit, trials, workers, seed, log
+        self.ckpts = shipped(hand)
+        self.student_modes = list(F.MODES)
+        if "student" in self.ckpts:  # a student distilled from some experts only is evaluated on those
+            import torch
+            ck = torch.load(CHECKPOINTS / hand / "student.pt", map_location="cpu", weights_only=False)
+            self.student_modes = list(ck.get("distilled_modes") or F.MODES)
+
+    def evaluate(self, mode: str, spec: str, objects: str, disturb: bool = False) -> str:
+        """One cell: ``spec`` on the protocol of ``mode`` (its axis only) over ``objects``."""
+        sk = skill_of_mode(mode)
+        axis = mode_axis(mode)
+        t0 = time.time()
+        try:
+            trials = E.run_protocol_workers(sk.name, spec, get_object_set(objects, limit=self.limit), hand=self.hand,
+                                            workers=self.workers, seed=self.seed, trials_per_object=self.trials,
+                                            disturb=disturb, axes=[axis] if axis else None, progress=False)
+        except ValueError as e:  # e.g. no grasp states for these objects
+            return f"not run: {e}"
+        self.log(f"  {spec} {mode} on {objects}{' --disturb' if disturb else ''}: {time.time() - t0:.0f} s")
+        return _cell(E.summarize(sk.name, trials), sk.name)
+
+    def _table(self, title: str, rows: List[tuple], paper_setting: str, note: str = "") -> List[str]:
+        lines = [f"## {title}", ""] + ([note, ""] if note else [])
+        lines += ["| mode | policy | result [95% CI] (n) | paper (SR / metric) |", "|---|---|---|---|"]
+        for mode, spec, cell in rows:
+            lines.append(f"| {mode} | {spec} | {cell} | {_paper(paper_setting, skill_of_mode(mode).name)} |")
+        return lines + [""]
+
+    def _per_mode(self, objects: str, disturb: bool, who: str) -> List[tuple]:
+        rows = []
+        for mode in F.MODES:
+            spec = self.ckpts.get("student" if who == "student" else mode)
+            if spec is None:
+                rows.append((mode, f"{who} not shipped", "--"))
+            elif who == "student" and mode not in self.student_modes:
+                rows.append((mode, f"{spec} (not distilled for this mode: no expert)", "--"))
+            else:
+                rows.append((mode, spec, self.evaluate(mode, spec, objects, disturb)))
+        return rows
+
+    def markdown(self, command: str) -> str:
+        lines = ["# Results (regenerated from the shipped checkpoints)", "",
+                 f"Command: `{command}`", "",
+                 f"Hand {self.hand}; first {self.limit or 'all'} objects per (category, shape) group x "
+                 f"{self.trials} trials per object and axis; seed {self.seed}; the paper's protocols "
+                 f"(`configs/eval.yaml`). Paper values: the full test set x 25 trials.", ""]
+        self.log("experts on test objects ...")
+        lines += self._table("Experts, held-out test objects", self._per_mode("test", False, "expert"), "Experts")
+        self.log("student on test objects ...")
+        lines += self._table("Student, held-out test objects", self._per_mode("test", False, "student"), "Ours")
+        self.log("unseen objects ...")
+        lines += self._table("Unseen objects (spheres, hexagonal and octagonal prisms)",
+                             self._per_mode("unseen", False, "expert"), "Uns.",
+                             "The experts (the paper reports its student here). In-hand protocols start from "
+                             "the grasp-state dataset, so they run on the unseen objects that have a grasp.")
+        self.log("disturbances ...")
+        lines += self._table("Disturbances (`--disturb`)", self._per_mode("test", True, "expert"), "Dis.",
+                             "The experts (the paper reports its student here).")
+        self.log("baselines ...")
+        base = [("relocate", "scripted-relocate", self.evaluate("relocate", "scripted-relocate", "test")),
+                ("relocate", "zero", self.evaluate("relocate", "zero", "test")),
+                ("relocate", "zero (`--disturb`)", self.evaluate("relocate", "zero", "test", disturb=True))]
+        lines += self._table("Baselines: the naive relocation and the zero action", base, "Gen. (Base.)",
+                             "Paper column: its retrained per-skill baselines (Gen.), not these.")
+        lines += ["## Long horizon", ""]
+        if "student" not in self.ckpts:
+            lines += ["Not run: needs the student (`unicross/checkpoints/<hand>/student.pt`), which is not "
+                      "shipped. Paper: " + "; ".join(f"{k} {v[-1]:g}% overall" for k, v in PAPER["long"].items()), ""]
+        else:
+            lines += self._long_horizon()
+        return "\n".join(lines)
+
+    def _long_horizon(self) -> List[str]:
+        from unicross.evaluation import chain_table, run_chain, summarize_chain, resolve_policy
+        policy, _ = resolve_policy(self.ckpts["student"], self.hand)
+        objs = get_object_set("test", limit=self.limit)
+        trials = run_chain(policy, objs, hand=self.hand, trials_per_object=self.trials, seed=self.seed, progress=False)
+        return [chain_table(summarize_chain(trials)), "",
+                "Paper: " + "; ".join(f"{k} {' / '.join(f'{x:g}' for x in v)}" for k, v in PAPER["long"].items()), ""]
+
+
+def paper_report(out: str, argv: List[str], **kwargs) -> str:
+    """Write the report to ``out`` (markdown); returns its text."""
+    command = "unicross " + " ".join(shlex.quote(a) for a in argv)
+    text = PaperReport(**kwargs).markdown(command)
+    Path(out).parent.mkdir(parents=True, exist_ok=True)
+    Path(out).write_text(text + "\n")
+    return text
