@@ -8,6 +8,17 @@ os.environ.setdefault("UNICROSS_CACHE", os.path.join(os.path.dirname(__file__), 
 os.environ.setdefault("UNICROSS_COMPILE", "0")
 
 
+@pytest.fixture(autouse=True)
+def _unit_tests_build_no_simulator(request, monkeypatch):
+    """Tests marked ``unit`` must not make an environment (the unit tier runs without SAPIEN)."""
+    if request.node.get_closest_marker("unit"):
+        import gymnasium
+
+        def refuse(*args, **kwargs):
+            raise AssertionError("a test marked unit made an environment")
+        monkeypatch.setattr(gymnasium, "make", refuse)
+
+
 @pytest.fixture(scope="session")
 def tiny_objects():
     from unicross.objects import get_object_set

@@ -1,10 +1,13 @@
 """The PPO algorithm on synthetic batches: no simulator, seconds."""
+import pytest
 import torch
 
 from unicross.config import load_config
 from unicross.rl.algorithm import PPO
 from unicross.rl.collector import make_buffer
 from unicross.rl.models import OBS_KEYS
+
+pytestmark = pytest.mark.unit
 
 DIMS = dict(hand=6, object=5, goal=4)
 N, T, A = 4, 64, 3

@@ -7,6 +7,8 @@ import trimesh
 from unicross.geometry import closest_point_shapes, quat_angle, quat_from_euler_xyz, quat_to_euler_xyz, slerp_toward
 from unicross.objects import ObjectSpec, get_object_set
 
+pytestmark = pytest.mark.unit
+
 TOL = 1e-3  # 1 mm
 
 

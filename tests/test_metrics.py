@@ -8,6 +8,8 @@ from unicross import metrics as M
 from unicross.evaluation import markdown_table, summarize
 from unicross.geometry import quat_from_axis_angle, quat_mul
 
+pytestmark = pytest.mark.unit
+
 
 def _spin(axis, step, n, start=None):
     axis = torch.tensor(axis, dtype=torch.float32)

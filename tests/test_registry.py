@@ -10,6 +10,7 @@ from unicross.config import load_config
 from unicross.rl.policy_io import check_modes, load_policy
 
 
+@pytest.mark.unit
 def test_modes_goal_and_axes_follow_the_registry():
     assert F.MODES == tuple(m for s in R.SKILLS.values() for m in s.modes)
     assert F.GOAL_DIM == len(F.MODES) + 3 + 2 * 21
@@ -22,6 +23,7 @@ def test_modes_goal_and_axes_follow_the_registry():
     assert F.SKILL_TARGETS == {s.name: s.targets for s in R.SKILLS.values()}
 
 
+@pytest.mark.unit
 def test_every_skill_is_a_registered_task_with_its_configured_length():
     lengths = load_config("task")["episode_length"]
     for s in R.SKILLS.values():
@@ -29,6 +31,7 @@ def test_every_skill_is_a_registered_task_with_its_configured_length():
         assert set(s.targets) == set(F.SLOTS)
 
 
+@pytest.mark.unit
 def test_axes_are_validated_with_the_valid_values_listed():
     with pytest.raises(ValueError, match=r"valid axes: \['x\+'"):
         R.skill("rotate").mode("w+")
@@ -41,6 +44,7 @@ def test_axes_are_validated_with_the_valid_values_listed():
     assert R.skill("translate").env_kwargs("z-") == {"direction": "z-"}
 
 
+@pytest.mark.unit
 def test_checkpoints_of_another_registry_are_refused():
     _, ck = load_policy("allegro/grasp")
     check_modes(ck, "allegro/grasp")  # the shipped checkpoints match this registry

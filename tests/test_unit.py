@@ -1,0 +1,164 @@
+"""The formulation and the reward terms on synthetic tensors: no simulator, seconds.
+
+Target rules (paper Table 1 as data), the action mapping, the goal features and every registered
+reward term are pure functions of batched tensors; these tests pin what they compute.
+"""
+import math
+
+import pytest
+import torch
+
+from unicross import formulation as F
+from unicross import rewards as RW
+from unicross.config import load_config
+from unicross.geometry import quat_angle, quat_from_axis_angle, quat_positive
+
+pytestmark = pytest.mark.unit
+
+P = F.MotionParams(dt=0.05, v_max=0.1, omega_max=1.0, relocate_v=0.3, relocate_omega=1.5)
+
+
+def random_relational(n: int, g: torch.Generator) -> F.Relational:
+    slots = {}
+    for s in F.SLOTS:
+        if s.startswith("x"):
+            slots[s] = 0.2 * torch.randn(n, 3, generator=g)
+        else:
+            q = torch.randn(n, 4, generator=g)
+            slots[s] = quat_positive(q / q.norm(dim=-1, keepdim=True))
+    return F.Relational(**slots)
+
+
+def batch(mode_names, seed=0):
+    g = torch.Generator().manual_seed(seed)
+    n = len(mode_names)
+    mode = torch.tensor([F.MODES.index(m) for m in mode_names])
+    cur, init = random_relational(n, g), random_relational(n, g)
+    final = random_relational(n, g)
+    axis = F.MODE_AXES[mode].float()
+    return mode, cur, init, final.x_or, final.q_or, axis
+
+
+def test_fixed_and_free_slots_follow_the_target_table():
+    mode, cur, init, fx, fq, axis = batch(list(F.MODES))
+    tgt = F.update_targets(mode, cur, init, fx, fq, axis, P)
+    for i, m in enumerate(F.MODES):
+        rules = F.SKILL_TARGETS[F.mode_skill(m)]
+        for s in F.SLOTS:
+            if rules[s] == "fixed":
+                assert torch.equal(getattr(tgt, s)[i], getattr(init, s)[i]), (m, s)
+            elif rules[s] == "free":
+                assert torch.equal(getattr(tgt, s)[i], getattr(cur, s)[i]), (m, s)
+
+
+def test_tracked_rules_move_at_their_speed():
+    mode, cur, init, fx, fq, axis = batch(["translate_z+", "rotate_x-", "relocate"])
+    tgt = F.update_targets(mode, cur, init, fx, fq, axis, P)
+    # translate: the hand-frame object target is one step of v_max along d^h
+    assert torch.allclose(tgt.x_oh[0] - cur.x_oh[0], P.v_max * P.dt * axis[0], atol=1e-7)
+    # rotate: one step of omega_max about d^h
+    assert quat_angle(tgt.q_oh[1:2], cur.q_oh[1:2]).item() == pytest.approx(P.omega_max * P.dt, abs=1e-5)
+    step = quat_positive(quat_from_axis_angle(axis[1:2], torch.tensor([P.omega_max * P.dt])))
+    assert torch.allclose(quat_angle(tgt.q_oh[1:2], cur.q_oh[1:2]), quat_angle(step, torch.tensor([[1.0, 0, 0, 0]])),
+                          atol=1e-5)
+    # relocate: the root-frame object target moves relocate_v * dt towards the final pose
+    d0 = torch.linalg.norm(fx[2] - cur.x_or[2])
+    d1 = torch.linalg.norm(fx[2] - tgt.x_or[2])
+    assert (d0 - d1).item() == pytest.approx(min(P.relocate_v * P.dt, d0.item()), abs=1e-6)
+
+
+def test_one_skill_path_equals_the_mixed_batch_path():
+    """Envs sharing one skill may take the single-rule path; it must equal the per-env selection."""
+    for m in ("grasp", "relocate", "rotate_y+", "translate_z-"):
+        mode, cur, init, fx, fq, axis = batch([m] * 4, seed=3)
+        mixed = F.update_targets(mode, cur, init, fx, fq, axis, P)
+        single = F.update_targets(mode, cur, init, fx, fq, axis, P, skill=F.mode_skill(m))
+        assert torch.allclose(mixed.flat(), single.flat(), atol=1e-7), m
+
+
+def test_action_mapping_wrist_from_target_and_fingers_from_command():
+    n, dof = 3, 22
+    g = torch.Generator().manual_seed(1)
+    a = torch.rand(n, dof, generator=g) * 2 - 1
+    prev = torch.randn(n, dof, generator=g)
+    ref = torch.randn(n, 6, generator=g)
+    scale = torch.full((dof,), 0.1)
+    lo, hi = torch.full((dof,), -10.0), torch.full((dof,), 10.0)
+    out = F.map_action(a, prev, ref, scale, lo, hi)
+    assert torch.allclose(out[:, :6], ref + 0.1 * a[:, :6])
+    assert torch.allclose(out[:, 6:], prev[:, 6:] + 0.1 * a[:, 6:])
+    ablated = F.map_action(a, prev, ref, scale, lo, hi, wrist_from_target=False)  # W/o target action
+    assert torch.allclose(ablated, prev + 0.1 * a)
+    clamped = F.map_action(torch.ones(n, dof), prev, ref, torch.full((dof,), 100.0), lo, hi)
+    assert torch.equal(clamped, hi.expand(n, dof))
+
+
+def test_goal_features_layout():
+    mode, cur, init, fx, fq, axis = batch(["rotate_z+", "grasp"])
+    g = F.goal_features(mode, axis, cur, init)
+    assert g.shape == (2, F.GOAL_DIM)
+    assert g[0, :F.NUM_MODES].argmax().item() == F.MODES.index("rotate_z+")
+    assert torch.equal(g[:, F.NUM_MODES:F.NUM_MODES + 3], axis)
+    assert torch.equal(g[:, -21:], init.flat())
+    assert torch.count_nonzero(F.goal_features(mode, axis, cur, init, zero_target=True)[:, -21:]) == 0
+
+
+def measurements(n: int, L: int = 5, seed: int = 0) -> dict:
+    g = torch.Generator().manual_seed(seed)
+    rel = random_relational(n, g)
+    return dict(link_distance=torch.rand(n, L, generator=g), contact=torch.rand(n, L, generator=g) > 0.5,
+                force_clipped=torch.rand(n, L, generator=g), speed_along_axis=torch.randn(n, generator=g),
+                speed_cap=torch.full((n,), 0.1), success=torch.rand(n, generator=g) > 0.5,
+                goal_err=torch.rand(n, 2, generator=g), goal_err_prev=torch.rand(n, 2, generator=g),
+                relational=rel, reward_targets=rel.clone(), finger_qpos=torch.randn(n, 16, generator=g),
+                finger_qpos0=torch.randn(n, 16, generator=g), hand_lin_vel=torch.randn(n, 3, generator=g),
+                hand_ang_vel=torch.randn(n, 3, generator=g), finger_torque=torch.randn(n, 16, generator=g),
+                drop=torch.rand(n, generator=g) > 0.8)
+
+
+def test_every_registered_term_is_computed_finite_and_per_env():
+    terms = RW.RewardTerms(load_config("reward"), "cpu")
+    mode = torch.arange(F.NUM_MODES)
+    out = terms(mode, measurements(F.NUM_MODES))
+    assert tuple(out) == RW.term_names()
+    for k, v in out.items():
+        assert v.shape == (F.NUM_MODES,) and torch.isfinite(v).all(), k
+
+
+def test_tracking_is_zero_on_target_and_saturates_when_lost():
+    terms = RW.RewardTerms(load_config("reward"), "cpu")
+    c = terms.coefficients("track")
+    m = measurements(4)
+    assert torch.allclose(RW.tracking_reward(m, c, torch.zeros(4, dtype=torch.long)), torch.zeros(4), atol=1e-5)
+    far = m["relational"].clone()
+    far.x_or = far.x_or + 100.0  # an object lost far away: the position part saturates
+    m2 = dict(m, relational=far)
+    r = RW.tracking_reward(m2, c, torch.zeros(4, dtype=torch.long))
+    assert torch.allclose(r, c["pos"][1] * torch.tensor(c["max_pos"]) ** 2, atol=1e-5)
+
+
+def test_contact_distance_saturates_and_motion_is_capped():
+    cfg = load_config("reward")
+    c = RW.RewardTerms(cfg, "cpu").coefficients("contact")
+    m = measurements(2)
+    mode = torch.tensor([F.MODES.index("grasp")] * 2)
+    near = RW.contact_reward(dict(m, link_distance=torch.full((2, 5), c["max_distance"])), c, mode)
+    far = RW.contact_reward(dict(m, link_distance=torch.full((2, 5), 50.0)), c, mode)
+    assert torch.equal(near, far)
+    cm = RW.RewardTerms(cfg, "cpu").coefficients("motion")
+    mode = torch.tensor([F.MODES.index("translate_z+")] * 2)
+    fast = RW.motion_reward(dict(m, speed_along_axis=torch.tensor([5.0, -5.0])), cm, mode)
+    w = cm["w_p"][mode[0]]
+    assert fast[0].item() == pytest.approx(float(w * 0.1))  # capped at v_max
+    assert fast[1].item() == pytest.approx(float(w * -5.0))  # not bounded below (see README, translate)
+
+
+def test_progress_term_telescopes_to_the_error_reduction():
+    """Potential-based: over any path the sum is w_pos (e_0 - e_T) + w_rot (theta_0 - theta_T)."""
+    c = RW.RewardTerms(load_config("reward"), "cpu").coefficients("progress")
+    mode = torch.tensor([F.MODES.index("relocate")])
+    g = torch.Generator().manual_seed(2)
+    errs = torch.rand(20, 1, 2, generator=g) * torch.tensor([0.05, math.pi])  # under the position cap
+    total = sum(RW.progress_reward(dict(goal_err_prev=errs[t - 1], goal_err=errs[t]), c, mode) for t in range(1, 20))
+    expect = c["w_pos"][mode] * (errs[0, :, 0] - errs[-1, :, 0]) + c["w_rot"][mode] * (errs[0, :, 1] - errs[-1, :, 1])
+    assert torch.allclose(total, expect, atol=1e-6)
