@@ -89,6 +89,8 @@ class DAggerTrainer:
         if self.ckpt is not None:
             experts_dir = experts_dir or self.ckpt["experts_dir"]
         self.cfg, self.experts_dir, self.progress = cfg, str(experts_dir), progress
+        self.commit = git_commit()  # the code this segment runs (a resume appends its own)
+        self.commits = list((self.ckpt or {}).get("commits", [])) + [self.commit]
         modes = cfg["env"]["modes"] or list(F.MODES)
         paths = expert_paths(experts_dir, modes)  # refuses to start without every expert
         self._seed(cfg["seed"])
@@ -117,7 +119,7 @@ class DAggerTrainer:
         self.optim = torch.optim.Adam(self.actor.parameters(), lr=cfg["optim"]["lr"])
         self.rb = TensorDictReplayBuffer(storage=LazyTensorStorage(cfg["buffer"]["capacity"], device=self.device),
                                          batch_size=cfg["optim"]["batch_size"])
-        self.epoch, self.frames = 0, 0
+        self.epoch, self.frames, self.wall_s = 0, 0, 0.0
         if self.ckpt is not None:
             self._load(self.ckpt)
         self.collector.set_actor(self.actor.module)  # after loading: the workers share these weights
@@ -130,10 +132,10 @@ class DAggerTrainer:
 
     def state(self) -> dict:
         return dict(policy=self.student.state_dict(), optim=self.optim.state_dict(), epoch=self.epoch,
-                    frames=self.frames, config=self.cfg, experts_dir=self.experts_dir, skill="multi", axis=None,
-                    hand=self.teachers.hand, obs_dims=self.dims, n_act=self.n_act, modes=list(F.MODES),
-                    distilled_modes=list(self.teachers.modes),
-                    git_commit=git_commit(),
+                    frames=self.frames, wall_s=self.wall_s, config=self.cfg, experts_dir=self.experts_dir,
+                    skill="multi", axis=None, hand=self.teachers.hand, obs_dims=self.dims, n_act=self.n_act,
+                    modes=list(F.MODES), distilled_modes=list(self.teachers.modes), git_commit=self.commit,
+                    commits=self.commits,
                     env_kwargs=self.env_kwargs,
                     rng=dict(torch=torch.get_rng_state(), numpy=np.random.get_state(), python=random.getstate()))
 
@@ -146,7 +148,7 @@ class DAggerTrainer:
     def _load(self, ck):
         self.student.load_state_dict(ck["policy"])
         self.optim.load_state_dict(ck["optim"])
-        self.epoch, self.frames = ck["epoch"], ck["frames"]
+        self.epoch, self.frames, self.wall_s = ck["epoch"], ck["frames"], ck.get("wall_s", 0.0)
         torch.set_rng_state(ck["rng"]["torch"])
         np.random.set_state(ck["rng"]["numpy"])
         random.setstate(ck["rng"]["python"])
@@ -217,6 +219,7 @@ class DAggerTrainer:
                 col = self.collect()
                 upd = self.update()
                 self.epoch += 1
+                self.wall_s += time.perf_counter() - t0
                 last = dict(epoch=self.epoch, frames=self.frames, buffer=len(self.rb),
                             seconds=time.perf_counter() - t0, **upd, **col)
                 with open(self.run_dir / "metrics.jsonl", "a") as f:
