@@ -3,8 +3,13 @@
 
     python benchmarks/plot_curves.py runs/grasp_s0 runs/grasp_s1 runs/grasp_s2 --out docs/grasp_curves.png
 
-Reads each run's ``metrics.jsonl`` (written by ``unicross train``). Needs matplotlib
-(``pip install matplotlib``).
+Reads each run's ``metrics.jsonl`` (written by ``unicross train``). DAgger runs (``unicross
+distill``) are drawn as the per-mode action MSE against the experts and the per-mode success of
+the student's own training episodes:
+
+    python benchmarks/plot_curves.py runs/student_s0 --out docs/student_curves.png
+
+Needs matplotlib (``pip install matplotlib``).
 """
 from __future__ import annotations
 
@@ -39,7 +44,10 @@ def main(argv=None) -> int:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     fig, (a, b) = plt.subplots(1, 2, figsize=(11, 4))
-    for run in map(Path, args.runs):
+    runs = list(map(Path, args.runs))
+    if all(is_dagger(r) for r in runs):
+        return plot_dagger(runs, fig, a, b, args)
+    for run in runs:
         evals, train = load(run)
         if evals:
             f = [r["frames"] for r in evals]
@@ -55,6 +63,10 @@ def main(argv=None) -> int:
     for ax in (a, b):
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8)
+    return save(fig, args)
+
+
+def save(fig, args) -> int:
     if args.title:
         fig.suptitle(args.title)
     fig.tight_layout()
@@ -62,6 +74,29 @@ def main(argv=None) -> int:
     fig.savefig(args.out, dpi=110)
     print(f"wrote {args.out}")
     return 0
+
+
+def is_dagger(run: Path) -> bool:
+    first = (run / "metrics.jsonl").read_text().split("\n", 1)[0]
+    return '"mse"' in first and '"epoch"' in first
+
+
+def plot_dagger(runs, fig, a, b, args) -> int:
+    for run in runs:
+        rows = [json.loads(line) for line in (run / "metrics.jsonl").read_text().splitlines() if line.strip()]
+        modes = sorted({k.split("/", 1)[1] for r in rows for k in r if k.startswith("mse/")})
+        for m in modes:
+            pts = [(r["frames"], r[f"mse/{m}"]) for r in rows if f"mse/{m}" in r]
+            a.plot([f for f, _ in pts], [v for _, v in pts], label=f"{run.name} {m}")
+            pts = [(r["frames"], 100 * r[f"success/{m}"]) for r in rows if f"success/{m}" in r]
+            b.plot([f for f, _ in pts], smooth([v for _, v in pts], 25), label=f"{run.name} {m}")
+    a.set(xlabel="frames", ylabel="action MSE to the expert", yscale="log", title="distillation loss per mode")
+    b.set(xlabel="frames", ylabel="success (%), smoothed", ylim=(-2, 102),
+          title="student's training episodes (randomised, perturbed)")
+    for ax in (a, b):
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8)
+    return save(fig, args)
 
 
 if __name__ == "__main__":

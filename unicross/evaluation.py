@@ -414,7 +414,7 @@ def summarize_chain(trials: List[dict]) -> Dict[str, dict]:
 def chain_table(summary: Dict[str, dict]) -> str:
     lines = ["| Sequence | Grasp SR | Relocate SR | In-hand SR | Overall SR |", "|---|---|---|---|---|"]
     for kind, s in summary.items():
-        cells = [f"{p['sr']:.1f} (n={p['n']})" for p in s["per_phase"]]
+        cells = [f"{p['sr']:.1f} [{p['ci95'][0]:.0f}-{p['ci95'][1]:.0f}] (n={p['n']})" for p in s["per_phase"]]
         lines.append(f"| {kind} | " + " | ".join(cells[:3]) + f" | {s['overall']['sr']:.1f} "
                      f"[{s['overall']['ci95'][0]:.0f}-{s['overall']['ci95'][1]:.0f}] (n={s['n']}) |")
     return "\n".join(lines)

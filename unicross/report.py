@@ -138,7 +138,10 @@ class PaperReport:
         policy, _ = resolve_policy(self.ckpts["student"], self.hand)
         objs = get_object_set("test", limit=self.limit)
         trials = run_chain(policy, objs, hand=self.hand, trials_per_object=self.trials, seed=self.seed, progress=False)
-        return [chain_table(summarize_chain(trials)), "",
+        missing = [m for m in F.MODES if m not in self.student_modes]
+        note = ([f"The student was distilled for {', '.join(self.student_modes)} only (no expert for "
+                 f"{', '.join(missing)}): phases of those modes are not expected to succeed.", ""] if missing else [])
+        return note + [chain_table(summarize_chain(trials)), "",
                 "Paper: " + "; ".join(f"{k} {' / '.join(f'{x:g}' for x in v)}" for k, v in PAPER["long"].items()), ""]
 
 

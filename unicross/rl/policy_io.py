@@ -37,7 +37,8 @@ def export_policy(run_checkpoint, out, sidecar: dict) -> Path:
     out = Path(out)
     out.parent.mkdir(parents=True, exist_ok=True)
     torch.save(small, out)
-    facts = {k: small[k] for k in ("skill", "axis", "hand", "iteration", "frames", "git_commit", "commits") if k in small}
+    facts = {k: small[k] for k in ("skill", "axis", "hand", "iteration", "epoch", "frames", "distilled_modes",
+                                   "git_commit", "commits") if k in small}
     out.with_suffix(".json").write_text(json.dumps({**facts, **sidecar}, indent=1) + "\n")
     return out
 
