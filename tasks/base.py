@@ -42,6 +42,7 @@ from unicross.objects import resolve_objects
 from unicross.rewards import RewardTerms
 from unicross.robots.hand import HAND_FRAME_LINK, HandSpec, load_hand, register_hand_agent
 from unicross.sensing import HandObjectSensor
+from unicross.success import get as success_test
 
 _HEAP_FROZEN = False
 
@@ -290,6 +291,7 @@ class UniCrossEnv(BaseEnv):
         self._drive_idx = torch.cat([self._qidx, self._midx])
         self.episode_length = torch.tensor([self.cfg["episode_length"][F.mode_skill(m)] for m in F.MODES], device=dev)
         self.rewards = RewardTerms(self.reward_cfg, dev, self.cfg["ablation"]["no_track_reward"])
+        self._success_tests = [success_test(s.success) for s in R.SKILLS.values()]  # in skill order
         self.motion = F.MotionParams(dt=self.control_dt, **self.cfg["motion"])
         self._speed_cap = torch.tensor([self.cfg["motion"][R.skill_of_mode(m).speed] for m in F.MODES], device=dev)
         self._gravity = float(abs(self.sim_config.scene_config.gravity[2]))  # m/s^2 (disturbance magnitudes)
@@ -725,21 +727,17 @@ class UniCrossEnv(BaseEnv):
         self._pending = torch.zeros_like(pend)
 
     def _success(self, m: Dict[str, torch.Tensor], skill):
-        """Success of each env's skill (DESIGN §6), never after a drop: grasp lifted with >= 2
-        contacts; relocate within the position/angle thresholds of the final pose; rotate/translate
-        accumulated past their thresholds. Returns (success, contact, lifted, pos_err, rot_err)."""
+        """Success of each env's skill (DESIGN §6), never after a drop: every skill's registered test
+        (``Skill.success``, unicross/success.py) on this step's measurements, each env taking its
+        skill's. Returns (success, contact, lifted, pos_err, rot_err)."""
         contact = m["force"] > self.cfg["contact_force_threshold"]
         lifted = (m["obj_p"][:, 2] - self.obj_z0) > self.cfg["grasp"]["lift_success"]
         fx, fq = pose_mul(self.root_p, self.root_q, self.final_x_or, self.final_q_or)
         pos_err = torch.linalg.norm(m["obj_p"] - fx, dim=-1)
         rot_err = quat_angle(m["obj_q"], fq)
-        sc = self.cfg["success"]
-        success_by_skill = torch.stack([
-            lifted & (contact.sum(-1) >= 2),
-            (pos_err < sc["relocate_pos"]) & (rot_err < sc["relocate_rot"]),
-            self.rot_acc > sc["rotate_angle"],
-            self.trans_acc > sc["translate_dist"],
-        ], dim=-1)
+        meas = dict(contact=contact, lifted=lifted, pos_err=pos_err, rot_err=rot_err, rot_acc=self.rot_acc,
+                    trans_acc=self.trans_acc)
+        success_by_skill = torch.stack([test(meas, self.cfg["success"]) for test in self._success_tests], dim=-1)
         success = success_by_skill.gather(1, skill[:, None])[:, 0] & ~self.ever_dropped
         return success, contact, lifted, pos_err, rot_err
 

@@ -83,3 +83,12 @@ def test_a_new_reward_term_is_one_registered_function(monkeypatch):
     assert torch.allclose(td["next", "info", "reward_bonus"], torch.full((2, 1), 0.5))
     assert torch.allclose(td["next", "reward"], sum(td["next", "info", f"reward_{t}"] for t in rewards.term_names()))
     tr.close()
+
+
+@pytest.mark.unit
+def test_every_skill_names_a_registered_success_test():
+    from unicross import success as S
+    for s in R.SKILLS.values():
+        assert S.get(s.success) is S.SUCCESS_TESTS[s.success]
+    with pytest.raises(ValueError, match="registered"):
+        S.get("no_such_test")

@@ -3,7 +3,8 @@
 Every structural fact about a skill lives in its :class:`Skill` entry below: its ManiSkill env
 id, its modes (axes or directions) and their hand-frame vectors, the object categories it works
 on, its default training set, the paper's PPO horizon, its evaluation protocol (steps, table
-column), the target rules of the paper's Table 1, and which motion speed caps its ``r_motion``.
+column), the target rules of the paper's Table 1, its success test (``unicross/success.py``) and
+which motion speed caps its ``r_motion``.
 Everything else iterates :data:`SKILLS` (modes, the mode one-hot and the goal size follow from
 it); tunable numbers (episode lengths, speeds, success thresholds, reward weights) live in
 ``configs/*.yaml``.
@@ -27,6 +28,7 @@ class Skill:
     env_id: str                       # the ManiSkill task id (tasks/skills.py registers it)
     short_name: str                   # long-horizon table label (paper: Gr., Re., Rot., Trans.)
     targets: Dict[str, str]           # relational slot -> target rule (paper Table 1; see formulation._RULES)
+    success: str                      # its success test (unicross/success.py)
     axes: Tuple[str, ...] = ()        # hand-frame axes of its modes ("x+", ...); () for a single axis-free mode
     axis_kwarg: Optional[str] = None  # the env constructor's argument that picks the axis
     categories: Tuple[str, ...] = BOTH_CATEGORIES  # object categories it trains and evaluates on
@@ -61,19 +63,21 @@ class Skill:
 
 _SKILL_LIST = (
     Skill("grasp", "UniCross-Grasp-v1", "Gr.",
-          targets=dict(x_oh="palm", q_oh="free", x_or="fixed", q_or="fixed", x_hr="free", q_hr="free")),
+          targets=dict(x_oh="palm", q_oh="free", x_or="fixed", q_or="fixed", x_hr="free", q_hr="free"),
+          success="lifted_with_contacts"),
     Skill("relocate", "UniCross-Relocate-v1", "Re.",
           targets=dict(x_oh="fixed", q_oh="fixed", x_or="interpolate", q_or="interpolate",
-                       x_hr="hand_from_object", q_hr="hand_from_object")),
+                       x_hr="hand_from_object", q_hr="hand_from_object"),
+          success="at_final_pose"),
     Skill("rotate", "UniCross-Rotate-v1", "Rot.",
           targets=dict(x_oh="fixed", q_oh="rotate_about_axis", x_or="fixed", q_or="object_from_hand",
-                       x_hr="fixed", q_hr="fixed"),
+                       x_hr="fixed", q_hr="fixed"), success="rotated_past_threshold",
           axes=("x+", "x-", "y+", "y-", "z+", "z-"), axis_kwarg="axis", categories=("wrappable",),
           train_objects="train-wrappable", ppo_horizon=8, protocol_steps=400, speed="omega_max",
           success_once=True),
     Skill("translate", "UniCross-Translate-v1", "Trans.",
           targets=dict(x_oh="translate_along_axis", q_oh="fixed", x_or="object_from_hand", q_or="fixed",
-                       x_hr="fixed", q_hr="fixed"),
+                       x_hr="fixed", q_hr="fixed"), success="translated_past_threshold",
           axes=("z+", "z-"), axis_kwarg="direction", categories=("elongated",),
           train_objects="train-elongated", ppo_horizon=8, protocol_steps=50, success_once=True),
 )
