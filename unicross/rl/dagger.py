@@ -7,20 +7,17 @@ of its mode (query rate 100%); the (observation, expert action) pairs go to a Te
 buffer (``LazyTensorStorage``, capacity 1e6 by default); the student then takes
 ``grad_steps`` MSE steps on sampled batches.
 
-The trainer refuses to start unless every mode has an expert checkpoint
+The trainer refuses to start unless every mode of ``env.modes`` (default: all ten) has an expert checkpoint
 (``<experts>/<mode>/checkpoint.pt``, the run directories of ``unicross train``).
 Checkpoints (student, optimiser, epoch, replay buffer, RNG) make runs resumable; per-mode action
 MSE and per-mode success rates are logged.
 """
 from __future__ import annotations
 
-import json
-import random
 import time
 from pathlib import Path
 from typing import Dict, Optional
 
-import numpy as np
 import torch
 from tensordict import TensorDict
 from torchrl.data import Bounded, LazyTensorStorage, TensorDictReplayBuffer
@@ -31,9 +28,7 @@ from unicross import formulation as F
 from unicross.rl.collector import LeanCollector
 from unicross.rl.models import OBS_KEYS, make_models
 from unicross.rl.policy_io import load_policy
-from unicross.rl.ppo import atomic_save, git_commit, open_run
-
-CKPT_NAME = "checkpoint.pt"
+from unicross.rl.runner import CKPT_NAME, Runner, atomic_save
 
 
 def expert_paths(experts_dir, modes=F.MODES) -> Dict[str, Path]:
@@ -79,21 +74,18 @@ class Teachers(torch.nn.Module):
         return out.clamp(-1.0, 1.0)
 
 
-class DAggerTrainer:
+class DAggerTrainer(Runner):
     def __init__(self, run_dir, experts_dir=None, overrides: Optional[dict] = None, resume: bool = False,
                  progress: bool = True):
-        self.run_dir = Path(run_dir)
         if not resume and experts_dir is None:
             raise ValueError("--experts is required")
-        self.ckpt, cfg = open_run(self.run_dir, resume, overrides, "dagger")
+        super().__init__(run_dir, resume, overrides, "dagger", progress)
+        cfg = self.cfg
         if self.ckpt is not None:
             experts_dir = experts_dir or self.ckpt["experts_dir"]
-        self.cfg, self.experts_dir, self.progress = cfg, str(experts_dir), progress
-        self.commit = git_commit()  # the code this segment runs (a resume appends its own)
-        self.commits = list((self.ckpt or {}).get("commits", [])) + [self.commit]
+        self.experts_dir = str(experts_dir)
         modes = cfg["env"]["modes"] or list(F.MODES)
         paths = expert_paths(experts_dir, modes)  # refuses to start without every expert
-        self._seed(cfg["seed"])
         ec = cfg["env"]
         kw = dict(randomize=ec["randomize"], reconfiguration_freq=ec["reconfiguration_freq"], modes=modes,
                   config=ec["task_config"] or None)
@@ -119,25 +111,17 @@ class DAggerTrainer:
         self.optim = torch.optim.Adam(self.actor.parameters(), lr=cfg["optim"]["lr"])
         self.rb = TensorDictReplayBuffer(storage=LazyTensorStorage(cfg["buffer"]["capacity"], device=self.device),
                                          batch_size=cfg["optim"]["batch_size"])
-        self.epoch, self.frames, self.wall_s = 0, 0, 0.0
+        self.epoch, self.frames = 0, 0
         if self.ckpt is not None:
             self._load(self.ckpt)
         self.collector.set_actor(self.actor.module)  # after loading: the workers share these weights
 
     # ------------------------------------------------------------------ state
-    def _seed(self, seed):
-        torch.manual_seed(seed)
-        np.random.seed(seed)
-        random.seed(seed)
-
     def state(self) -> dict:
-        return dict(policy=self.student.state_dict(), optim=self.optim.state_dict(), epoch=self.epoch,
-                    frames=self.frames, wall_s=self.wall_s, config=self.cfg, experts_dir=self.experts_dir,
-                    skill="multi", axis=None, hand=self.teachers.hand, obs_dims=self.dims, n_act=self.n_act,
-                    modes=list(F.MODES), distilled_modes=list(self.teachers.modes), git_commit=self.commit,
-                    commits=self.commits,
-                    env_kwargs=self.env_kwargs,
-                    rng=dict(torch=torch.get_rng_state(), numpy=np.random.get_state(), python=random.getstate()))
+        return dict(**self.runner_state(), policy=self.student.state_dict(), optim=self.optim.state_dict(),
+                    epoch=self.epoch, frames=self.frames, experts_dir=self.experts_dir, skill="multi", axis=None,
+                    hand=self.teachers.hand, obs_dims=self.dims, n_act=self.n_act, modes=list(F.MODES),
+                    distilled_modes=list(self.teachers.modes), env_kwargs=self.env_kwargs)
 
     def save(self):
         self.run_dir.mkdir(parents=True, exist_ok=True)
@@ -148,10 +132,8 @@ class DAggerTrainer:
     def _load(self, ck):
         self.student.load_state_dict(ck["policy"])
         self.optim.load_state_dict(ck["optim"])
-        self.epoch, self.frames, self.wall_s = ck["epoch"], ck["frames"], ck.get("wall_s", 0.0)
-        torch.set_rng_state(ck["rng"]["torch"])
-        np.random.set_state(ck["rng"]["numpy"])
-        random.setstate(ck["rng"]["python"])
+        self.epoch, self.frames = ck["epoch"], ck["frames"]
+        self.load_runner_state(ck)
         if (self.run_dir / "replay").exists():
             self.rb.loads(self.run_dir / "replay")
 
@@ -210,7 +192,7 @@ class DAggerTrainer:
 
     def train(self, epochs: Optional[int] = None) -> dict:
         target = self.cfg["optim"]["epochs"] if epochs is None else self.epoch + epochs
-        self.run_dir.mkdir(parents=True, exist_ok=True)
+        self.open_logs()
         bar = tqdm(total=target, initial=self.epoch, desc="dagger", unit="epoch", disable=not self.progress)
         last = {}
         try:
@@ -219,11 +201,10 @@ class DAggerTrainer:
                 col = self.collect()
                 upd = self.update()
                 self.epoch += 1
-                self.wall_s += time.perf_counter() - t0
-                last = dict(epoch=self.epoch, frames=self.frames, buffer=len(self.rb),
+                last = dict(epoch=self.epoch, frames=self.frames, wall_s=self._wall(), buffer=len(self.rb),
                             seconds=time.perf_counter() - t0, **upd, **col)
-                with open(self.run_dir / "metrics.jsonl", "a") as f:
-                    f.write(json.dumps(last) + "\n")
+                self.log_json(last)
+                self.log_scalars(last, self.frames)
                 if self.epoch % self.cfg["logging"]["checkpoint_every"] == 0:
                     self.save()
                 bar.update(1)
@@ -231,6 +212,7 @@ class DAggerTrainer:
         finally:
             self.save()
             bar.close()
+            self.close_logs()
         return last
 
     def close(self):

@@ -12,29 +12,22 @@ continues the same run directory at the next iteration. Metrics go to ``metrics.
 """
 from __future__ import annotations
 
-import csv
 import json
 import os
-import random
-import subprocess
 import time
-from pathlib import Path
 from typing import Optional
 
-import numpy as np
 import torch
 from tensordict import TensorDict
 from tqdm import tqdm
 
 from unicross import formulation as F
 from unicross import registry as R
-from unicross.config import deep_merge, load_config
 from unicross.rewards import term_names
 from unicross.rl.algorithm import PPO
 from unicross.rl.collector import LeanCollector
 from unicross.rl.models import OBS_KEYS  # noqa: F401  (re-exported for benchmarks)
-
-CKPT_NAME = "checkpoint.pt"
+from unicross.rl.runner import CKPT_NAME, Runner, atomic_save, git_commit, open_run  # noqa: F401  (re-exported)
 
 
 def resolve_num_envs(num_envs, backend: str, ray_address: Optional[str] = None) -> int:
@@ -73,38 +66,6 @@ def csv_fields() -> list:
     return CSV_BASE + [f"reward_{t}" for t in term_names()]
 
 
-def git_commit() -> str:
-    try:
-        return subprocess.check_output(["git", "rev-parse", "HEAD"], cwd=Path(__file__).parent,
-                                       stderr=subprocess.DEVNULL).decode().strip()
-    except Exception:
-        return "unknown"
-
-
-def atomic_save(obj, path: Path) -> None:
-    tmp = path.with_name(path.name + ".tmp")
-    torch.save(obj, tmp)
-    with open(tmp, "rb") as f:
-        os.fsync(f.fileno())
-    os.replace(tmp, path)
-
-
-def open_run(run_dir: Path, resume: bool, overrides: Optional[dict], config_name: str):
-    """(checkpoint or None, config) of a run directory: resume needs its checkpoint (whose config
-    the overrides update); a new run refuses to overwrite one and starts from ``configs/<name>``."""
-    ckpt_path = run_dir / CKPT_NAME
-    if resume:
-        if not ckpt_path.exists():
-            raise FileNotFoundError(f"cannot resume: no checkpoint at {ckpt_path}")
-        ckpt = torch.load(ckpt_path, map_location="cpu", weights_only=False)
-        from unicross.rl.policy_io import check_modes
-        check_modes(ckpt, ckpt_path)
-        return ckpt, deep_merge(ckpt["config"], overrides)
-    if ckpt_path.exists():
-        raise FileExistsError(f"{ckpt_path} exists: pass --resume to continue it or choose another --out")
-    return None, load_config(config_name, overrides)
-
-
 def env_kwargs_for(skill: str, axis: Optional[str], hand: str, env_cfg: dict) -> dict:
     """The env constructor arguments of one expert (validates skill and axis before any simulation)."""
     kw = dict(R.skill(skill).env_kwargs(axis), hand=hand, randomize=env_cfg["randomize"],
@@ -131,25 +92,20 @@ def evaluation_shard(actor, skill: str, objects: str, limit, trials_per_object: 
                           axes=[axis] if axis else None, ablation=ablation, shard=shard)
 
 
-class PPOTrainer:
+class PPOTrainer(Runner):
     """One expert: ``skill`` (+ ``axis`` for rotate/translate) on ``hand``."""
 
     def __init__(self, run_dir, skill: str = "grasp", axis: Optional[str] = None, hand: str = "allegro",
                  overrides: Optional[dict] = None, resume: bool = False, progress: bool = True):
-        self.run_dir = Path(run_dir)
-        self.ckpt, cfg = open_run(self.run_dir, resume, overrides, "ppo")
+        super().__init__(run_dir, resume, overrides, "ppo", progress)
+        cfg = self.cfg
         if self.ckpt is not None:
             skill, axis, hand = self.ckpt["skill"], self.ckpt["axis"], self.ckpt["hand"]
         from unicross.robots.hand import load_hand
         load_hand(hand)  # validates
-        self.skill, self.axis, self.hand, self.cfg = skill, axis, hand, cfg
-        # the code this segment runs (read once: HEAD may move while a long run trains)
-        self.commit = git_commit()
-        self.commits = list((self.ckpt or {}).get("commits", [])) + [self.commit]
+        self.skill, self.axis, self.hand = skill, axis, hand
         self.env_id = R.skill(skill).env_id
         self.env_kwargs = env_kwargs_for(skill, axis, hand, cfg["env"])
-        self.progress = progress
-        self._seed_everything(cfg["seed"])
         ec, ray_address = cfg["env"], cfg["collector"].get("ray_address")
         if ray_address and ec["backend"] != "physx_cpu":
             raise ValueError("collector.ray_address runs CPU env actors: it needs env.backend physx_cpu")
@@ -173,9 +129,6 @@ class PPOTrainer:
         dims, self.n_act = self.collector.dims, self.collector.n_act
         self.algo = PPO(dims, self.n_act, cfg, self.collector.frames_per_batch, self.device)
         self.iteration, self.frames = 0, 0
-        self._writer = None  # TensorBoard, open while train() runs
-        self.wall_s = 0.0  # training wall-clock over all segments of the run (collection, updates, evaluations)
-        self._wall_mark = time.perf_counter()
         self.dims = dims
         if self.ckpt is not None:
             self._load_state(self.ckpt)
@@ -183,11 +136,6 @@ class PPOTrainer:
         self._ep_return = torch.zeros(num_envs, 1, device=self.device)
 
     # ------------------------------------------------------------------ state
-    def _seed_everything(self, seed: int):
-        torch.manual_seed(seed)
-        np.random.seed(seed)
-        random.seed(seed)
-
     # the algorithm's parts, for inspection
     policy = property(lambda self: self.algo.policy)
     value = property(lambda self: self.algo.value)
@@ -195,23 +143,15 @@ class PPOTrainer:
     optim = property(lambda self: self.algo.optim)
 
     def state(self) -> dict:
-        return dict(**self.algo.state_dict(),
-                    iteration=self.iteration, frames=self.frames, wall_s=self._wall(), config=self.cfg, skill=self.skill,
+        return dict(**self.algo.state_dict(), **self.runner_state(),
+                    iteration=self.iteration, frames=self.frames, skill=self.skill,
                     axis=self.axis, hand=self.hand, env_id=self.env_id, env_kwargs=self.env_kwargs,
-                    obs_dims=self.dims, n_act=self.n_act, modes=list(F.MODES), git_commit=self.commit, commits=self.commits,
-                    rng=dict(torch=torch.get_rng_state(), numpy=np.random.get_state(), python=random.getstate()))
+                    obs_dims=self.dims, n_act=self.n_act, modes=list(F.MODES))
 
     def _load_state(self, ck: dict):
         self.algo.load_state_dict(ck)
         self.iteration, self.frames = ck["iteration"], ck["frames"]
-        self.wall_s, self._wall_mark = float(ck.get("wall_s", 0.0)), time.perf_counter()
-        torch.set_rng_state(ck["rng"]["torch"])
-        np.random.set_state(ck["rng"]["numpy"])
-        random.setstate(ck["rng"]["python"])
-
-    def save(self):
-        self.run_dir.mkdir(parents=True, exist_ok=True)
-        atomic_save(self.state(), self.run_dir / CKPT_NAME)
+        self.load_runner_state(ck)
 
     # ------------------------------------------------------------------ evaluation
     @torch.no_grad()
@@ -266,13 +206,11 @@ class PPOTrainer:
     def train(self, max_iterations: Optional[int] = None, eval_at_ends: bool = True) -> dict:
         """Collect and update until ``collector.total_frames`` (or ``max_iterations`` more
         iterations), with the held-out evaluations of ``logging``; returns their summaries."""
-        self._writer = self._tb()
+        self.open_logs()
         try:
             return self._train(max_iterations, eval_at_ends)
         finally:
-            if self._writer is not None:
-                self._writer.close()
-            self._writer = None
+            self.close_logs()
 
     def _train(self, max_iterations: Optional[int], eval_at_ends: bool) -> dict:
         total = self.cfg["collector"]["total_frames"]
@@ -356,50 +294,17 @@ class PPOTrainer:
         return dict(success=summ["sr"] / 100.0, ci95_low=summ["ci95"][0] / 100.0, ci95_high=summ["ci95"][1] / 100.0,
                     n=summ["n"])
 
-    def _wall(self) -> float:
-        now = time.perf_counter()
-        self.wall_s += now - self._wall_mark
-        self._wall_mark = now
-        return self.wall_s
-
     def _log_eval(self, row: dict) -> None:
         """Evaluation rows go to metrics.jsonl, eval.csv and TensorBoard (``eval/*``)."""
         row = {"iteration": self.iteration, "frames": self.frames, "wall_s": self._wall(), **row}
-        self._log_json(row)
-        self._append_csv("eval.csv", row, list(row))
-        if self._writer is not None:
-            for k, v in row.items():
-                if k not in ("iteration", "frames"):
-                    self._writer.add_scalar(f"eval/{k}", v, self.frames)
-
-    # ------------------------------------------------------------------ logging
-    def _tb(self):
-        try:
-            from torch.utils.tensorboard import SummaryWriter
-        except Exception:  # tensorboard missing: CSV/JSON logs still work
-            return None
-        return SummaryWriter(str(self.run_dir / "tb"))
-
-    def _log_json(self, row: dict):
-        with open(self.run_dir / "metrics.jsonl", "a") as f:
-            f.write(json.dumps(row) + "\n")
-
-    def _append_csv(self, name: str, row: dict, fields) -> None:
-        path = self.run_dir / name
-        new = not path.exists()
-        with open(path, "a", newline="") as f:
-            w = csv.DictWriter(f, fieldnames=fields, extrasaction="ignore")
-            if new:
-                w.writeheader()
-            w.writerow(row)
+        self.log_json(row)
+        self.append_csv("eval.csv", row, list(row))
+        self.log_scalars(row, self.frames, prefix="eval/")
 
     def _log(self, row: dict):
-        self._log_json(row)
-        self._append_csv("metrics.csv", row, csv_fields())
-        if self._writer is not None:
-            for k, v in row.items():
-                if k not in ("iteration", "frames") and isinstance(v, (int, float)):
-                    self._writer.add_scalar(k, v, self.frames)
+        self.log_json(row)
+        self.append_csv("metrics.csv", row, csv_fields())
+        self.log_scalars(row, self.frames)
 
     def close(self):
         try:
