@@ -1,0 +1,184 @@
+"""The per-step tensor math of the task (part of :class:`unicross.tasks.base.UniCrossEnv`).
+
+:class:`StepMath` holds what happens between the simulator's reads and the next action: the action
+-> joint command map, the measurements (link-to-surface vectors, finger torques), relational poses,
+accumulated motion, drop, success, the reward terms, the next targets and the observation parts.
+It is pure tensor math on the task state (no reads, no random draws), compiled to one graph per
+process when ``UNICROSS_COMPILE`` is on (``unicross/compiling.py``).
+"""
+from __future__ import annotations
+
+from typing import Dict
+
+import torch
+
+from unicross import formulation as F
+from unicross.geometry import (
+    closest_point_shapes, pose_mul, quat_apply,
+    quat_angle, quat_inv,
+)
+
+
+class StepMath:
+    """Per-step math of the UniCross task (a mixin of ``UniCrossEnv``)."""
+
+    def _command_math_eager(self, a: torch.Tensor, elapsed_steps: torch.Tensor) -> torch.Tensor:
+        """The normalised action [-1, 1] -> this step's joint command (``self.command``; the wrist
+        reference is the target hand pose, raised during the grasp lift) -> the drive targets of all
+        driven joints. Pure tensor math on the task state, compiled like ``_step_math_eager``."""
+        a = a.clamp(-1.0, 1.0)
+        ref = F.wrist_reference(self.targets)
+        ref[:, :3] = ref[:, :3] + self._advance_lift(elapsed_steps)
+        self.command = F.map_action(a, self.command, ref, self.action_scale, self.q_lower, self.q_upper,
+                                    wrist_from_target=not self.cfg["ablation"]["no_target_action"])
+        return self._drive_targets()
+
+    def _advance_lift(self, elapsed_steps: torch.Tensor) -> torch.Tensor:
+        """Grasp lift phase: the wrist reference (the Free current wrist pose) rises by
+        ``lift_speed * dt`` per step after ``lift_after`` steps; ``self.lift`` accumulates the rise,
+        which the Fixed object target follows. Returns this step's increment (root frame)."""
+        lift_after = self.cfg["grasp"]["lift_after"]
+        if lift_after is None or self.static_skill not in (None, "grasp"):
+            return torch.zeros_like(self.lift)
+        lifting = (self.mode == F.mode_index("grasp")) & (elapsed_steps >= lift_after)
+        up_root = quat_apply(quat_inv(self.root_q), self._world_up.expand_as(self.lift))
+        step = lifting[:, None].float() * up_root * self.cfg["grasp"]["lift_speed"] * self.control_dt
+        self.lift = self.lift + step
+        return step
+
+    def _measure(self, pos, quat, force, qpos, qvel) -> Dict[str, torch.Tensor]:
+        hand_p, hand_q = pos[:, 0], quat[:, 0]
+        link_p, link_q = pos[:, 1:-1], quat[:, 1:-1]
+        obj_p, obj_q = pos[:, -1], quat[:, -1]
+        L = link_p.shape[1]
+        probe_w = link_p + quat_apply(link_q, self.link_probe.expand(self.num_envs, L, 3))
+        inv_q = quat_inv(obj_q)[:, None].expand(-1, L, 4)
+        probe_o = quat_apply(inv_q, probe_w - obj_p[:, None])
+        closest_o = closest_point_shapes(probe_o, self.obj_shape, self.obj_params, self.obj_tris, self._closest_kinds)
+        vec_w = quat_apply(obj_q[:, None].expand(-1, L, 4), closest_o - probe_o)  # link -> surface, world axes
+        vec_h = quat_apply(quat_inv(hand_q)[:, None].expand(-1, L, 4), vec_w)      # ... in the hand frame
+        q = qpos[:, self._qidx]
+        qd = qvel[:, self._qidx]
+        kp, kd, fl = self._finger_pd
+        torque = torch.clamp(kp * (self.command[:, 6:] - q[:, 6:]) - kd * qd[:, 6:], -fl, fl)
+        return dict(hand_p=hand_p, hand_q=hand_q, obj_p=obj_p, obj_q=obj_q, link_vec=vec_h,
+                    link_distance=torch.linalg.norm(vec_h, dim=-1), force=force, qpos=q,
+                    finger_torque=torque)
+
+    def _step_math_eager(self, pos, quat, force, qpos, qvel, elapsed_steps) -> dict:
+        """Everything ``evaluate()`` computes from the step's reads: distances, relational poses,
+        velocities, accumulated motion, drop, success, reward terms, the next targets and the
+        observation parts. Pure tensor math on the task's state (no reads, no random draws), so it
+        compiles to one graph (``UNICROSS_COMPILE``)."""
+        m = self._measure(pos, quat, force, qpos, qvel)
+        cur = F.relational_poses(self.root_p, self.root_q, m["hand_p"], m["hand_q"], m["obj_p"], m["obj_q"])
+        pend = self._pending
+        skill = F.MODE_SKILL_ID.to(self.device)[self.mode]
+        axis_prev = self.axis
+        goal_err_prev, goal_err = self._goal_errors(cur)
+        self._advance_motion(cur, pend, skill, axis_prev)
+        # reward compares against the targets the last action aimed at; Free targets = current
+        reward_targets = F.with_free_as_current(self.mode, self.targets, cur)
+        drop = self._drop(m["link_distance"], skill, elapsed_steps)
+        self._advance_targets(cur, pend)
+        success, contact, lifted, pos_err, rot_err = self._success(m, skill)
+        force_c = m["force"].clamp(max=self.cfg["force_clip"])
+        # motion along the axis the last action was asked to follow
+        is_rot = skill == F.skill_id("rotate")
+        speed = torch.where(is_rot, (self.obj_angvel_h * axis_prev).sum(-1), (self.obj_vel_h * axis_prev).sum(-1))
+        meas = dict(link_distance=m["link_distance"], contact=contact, force_clipped=force_c, speed_along_axis=speed,
+                    speed_cap=self._speed_cap[self.mode], relational=cur, reward_targets=reward_targets,
+                    finger_qpos=m["qpos"][:, 6:], finger_qpos0=self.finger_q0, hand_lin_vel=self.hand_vel,
+                    hand_ang_vel=self.hand_angvel, finger_torque=m["finger_torque"], drop=drop, success=success,
+                    goal_err_prev=goal_err_prev, goal_err=goal_err)
+        terms = self.rewards(self.mode, meas)
+        self._observation_parts(m, cur, contact, force_c)
+        info = dict(success=success, fail=drop, drop=drop, ever_dropped=self.ever_dropped.clone(),
+                    lifted=lifted, relocate_pos_err=pos_err, relocate_rot_err=rot_err,
+                    rotation=self.rot_acc.clone(), translation=self.trans_acc.clone(),
+                    num_contacts=contact.sum(-1), mode=self.mode.clone())
+        info.update({f"reward_{k}": v for k, v in terms.items()})
+        return info
+
+    def _goal_errors(self, cur: F.Relational):
+        """The object's position (m) and angle (rad) error to its final root-frame pose before and
+        after the step ([N, 2] each; ``r_progress``)."""
+        prev = self.prev_rel
+        before = torch.stack([torch.linalg.norm(prev.x_or - self.final_x_or, dim=-1),
+                              quat_angle(prev.q_or, self.final_q_or)], dim=-1)
+        after = torch.stack([torch.linalg.norm(cur.x_or - self.final_x_or, dim=-1),
+                             quat_angle(cur.q_or, self.final_q_or)], dim=-1)
+        return before, after
+
+    def _advance_motion(self, cur: F.Relational, pend, skill, axis_prev):
+        """Velocities over the last control step (object in the hand frame, hand in the root frame)
+        and the rotation / translation accumulated along the mode's axis, once per control step."""
+        dt = self.control_dt
+        (xp, qp), (xc, qc) = self.prev_rel.poses(), cur.poses()
+        vel, angvel = F.finite_velocity(xp[:, ::2], qp[:, ::2], xc[:, ::2], qc[:, ::2], dt)
+        v, w, hv, hw = vel[:, 0], angvel[:, 0], vel[:, 1], angvel[:, 1]
+        p1 = pend[:, None]
+        self.obj_vel_h = torch.where(p1, v, self.obj_vel_h)
+        self.obj_angvel_h = torch.where(p1, w, self.obj_angvel_h)
+        self.hand_vel = torch.where(p1, hv, self.hand_vel)
+        self.hand_angvel = torch.where(p1, hw, self.hand_angvel)
+        is_rot = skill == F.skill_id("rotate")
+        is_trans = skill == F.skill_id("translate")
+        self.rot_acc = self.rot_acc + (pend & is_rot).float() * (w * axis_prev).sum(-1) * dt
+        self.trans_acc = self.trans_acc + (pend & is_trans).float() * (v * axis_prev).sum(-1) * dt
+
+    def _drop(self, dist, skill, elapsed_steps):
+        """Drop (DESIGN §6): every link farther than ``drop_threshold`` from the object; a grasp can
+        only drop what it lifted (before the lift phase the object rests on the table)."""
+        drop = dist.min(dim=-1).values > self.cfg["drop_threshold"]
+        lift_after = self.cfg["grasp"]["lift_after"]
+        grasp_lifting = (elapsed_steps >= lift_after) if lift_after is not None else torch.zeros_like(drop)
+        drop = drop & ((skill != F.skill_id("grasp")) | grasp_lifting)
+        self.ever_dropped = self.ever_dropped | drop
+        return drop
+
+    def _advance_targets(self, cur: F.Relational, pend):
+        """The next targets and task axis, once per control step. After a drop they hold still: a
+        lost object's pose no longer defines where the hand should go (Tracked hand targets would
+        chase it; measured: the wrist reference jumped and slammed the hand at 11 m/s in a relocate
+        episode without termination)."""
+        axis = F.task_axis(self.mode, cur, self.final_x_or)
+        init = self.init_rel.clone()
+        init.x_or = init.x_or + self.lift
+        new_t = F.update_targets(self.mode, cur, init, self.final_x_or, self.final_q_or, axis, self.motion,
+                                 skill=self.static_skill)
+        self.targets = new_t.where(pend & ~self.ever_dropped, self.targets)
+        self.axis = torch.where(pend[:, None], axis, self.axis)
+        self.prev_rel = cur.where(pend, self.prev_rel)
+        self.cur_rel = cur
+        self._pending = torch.zeros_like(pend)
+
+    def _success(self, m: Dict[str, torch.Tensor], skill):
+        """Success of each env's skill (DESIGN §6), never after a drop: every skill's registered test
+        (``Skill.success``, unicross/success.py) on this step's measurements, each env taking its
+        skill's. Returns (success, contact, lifted, pos_err, rot_err)."""
+        contact = m["force"] > self.cfg["contact_force_threshold"]
+        lifted = (m["obj_p"][:, 2] - self.obj_z0) > self.cfg["grasp"]["lift_success"]
+        fx, fq = pose_mul(self.root_p, self.root_q, self.final_x_or, self.final_q_or)
+        pos_err = torch.linalg.norm(m["obj_p"] - fx, dim=-1)
+        rot_err = quat_angle(m["obj_q"], fq)
+        meas = dict(contact=contact, lifted=lifted, pos_err=pos_err, rot_err=rot_err, rot_acc=self.rot_acc,
+                    trans_acc=self.trans_acc)
+        success_by_skill = torch.stack([test(meas, self.cfg["success"]) for test in self._success_tests], dim=-1)
+        success = success_by_skill.gather(1, skill[:, None])[:, 0] & ~self.ever_dropped
+        return success, contact, lifted, pos_err, rot_err
+
+    def _observation_parts(self, m: Dict[str, torch.Tensor], cur: F.Relational, contact, force_c):
+        """The observation's parts with the ablations applied (``_obs_parts``; the noise on joint
+        readings is added when observed, since it is drawn after this math) and the measurements as
+        measured (``_measured``: recordings, renders)."""
+        ab = self.cfg["ablation"]
+        obs_contact, obs_force = contact.float(), force_c
+        obs_vec = m["link_vec"].reshape(self.num_envs, -1)
+        if ab["no_contact"]:
+            obs_contact, obs_force = torch.zeros_like(obs_contact), torch.zeros_like(obs_force)
+        if ab["no_distance"]:
+            obs_vec = torch.zeros_like(obs_vec)
+        goal = F.goal_features(self.mode, self.axis, cur, self.targets, zero_target=ab["no_target_obs"])
+        self._obs_parts = dict(qpos=m["qpos"], contact=obs_contact, force=obs_force, distance=obs_vec, goal=goal)
+        self._measured = dict(qpos=m["qpos"], contact=contact, force=force_c, vec=m["link_vec"])
