@@ -68,59 +68,84 @@ class ChainEnv(UniCrossEnv):
                              f"(rotate needs wrappable objects, translate elongated ones)")
         super().__init__(*args, modes=("grasp",), objects=objs, config=cfg, **kwargs)
 
+    TASK_STATE = UniCrossEnv.TASK_STATE + ("phase", "phase_success")
+
+    def _alloc_buffers(self):
+        super()._alloc_buffers()
+        n, dev, p = self.num_envs, self.device, len(self.sequence)
+        self.phase = torch.zeros(n, dtype=torch.long, device=dev)  # per env: partial resets restart one env
+        self.phase_success = torch.zeros(n, p, dtype=torch.bool, device=dev)
+        self._phase_end = torch.tensor(self.phase_ends, device=dev)
+        self._phase_mode = torch.tensor([F.MODES.index(m) for m in self.sequence], device=dev)
+        self._phase_once = torch.tensor([SKILLS[F.mode_skill(m)].success_once for m in self.sequence], device=dev)
+
     def _initialize_episode(self, env_idx, options):
         super()._initialize_episode(env_idx, options)
-        n = self.num_envs
-        self.phase = 0
-        self.static_skill = "grasp"
-        self.phase_success = torch.zeros(n, len(self.sequence), dtype=torch.bool, device=self.device)
-        self.mode[env_idx] = F.MODES.index(self.sequence[0])
+        self.phase[env_idx] = 0
+        self.phase_success[env_idx] = False
+        self.mode[env_idx] = self._phase_mode[0]
+        self._set_static_skill()
+
+    def load_task_state(self, task, env_idx=None):
+        super().load_task_state(task, env_idx)
+        self._set_static_skill()
+
+    def _set_static_skill(self):
+        """The target update skips other skills' rules when every env is in the same phase."""
+        phases = torch.unique(self.phase).tolist()
+        self.static_skill = F.mode_skill(self.sequence[phases[0]]) if len(phases) == 1 else None
 
     # ------------------------------------------------------------------ stepping
     def step(self, action):
         obs, reward, terminated, truncated, info = super().step(action)
-        skill = F.mode_skill(self.sequence[self.phase])
-        at_end = int(self.elapsed_steps[0]) >= self.phase_ends[self.phase]
-        if SKILLS[skill].success_once:  # "exceeded within the phase"
-            self.phase_success[:, self.phase] |= info["success"]
-        elif at_end:
-            self.phase_success[:, self.phase] = info["success"]
-        if at_end and self.phase + 1 < len(self.sequence):
-            self._switch_phase(self.phase + 1)
+        envs = torch.arange(self.num_envs, device=self.device)
+        ph = self.phase
+        at_end = self.elapsed_steps >= self._phase_end[ph]
+        seen = self.phase_success[envs, ph]
+        # rotate/translate: "exceeded within the phase"; grasp/relocate: at the end of the phase
+        self.phase_success[envs, ph] = torch.where(self._phase_once[ph], seen | info["success"],
+                                                   torch.where(at_end, info["success"], seen))
+        switch = at_end & (ph + 1 < len(self.sequence))
+        if bool(switch.any()):
+            self._switch_phase(switch.nonzero()[:, 0])
             info = self.get_info()
             obs = self.get_obs(info)
-        truncated = torch.full_like(truncated, int(self.elapsed_steps[0]) >= self.phase_ends[-1])
-        info["phase"] = torch.full((self.num_envs,), self.phase, device=self.device)
+        truncated = self.elapsed_steps >= self._phase_end[-1]
+        info["phase"] = self.phase.clone()
         info["phase_success"] = self.phase_success.clone()
         return obs, reward, terminated, truncated, info
 
-    def _switch_phase(self, k: int):
-        """Re-base the root frame on the current hand pose and re-instantiate the targets."""
-        dev, n, robot = self.device, self.num_envs, self.agent.robot
+    def _switch_phase(self, env_idx: torch.Tensor):
+        """Envs ``env_idx`` go to their next phase: re-base the root frame on the current hand pose and
+        re-instantiate the targets. Writes whole batches (the other envs get their current values back),
+        so it needs no partial-reset mask on the GPU backend."""
+        robot = self.agent.robot
         pos, quat = self.sensor.poses()
         hand_p, hand_q, obj_p, obj_q = pos[:, 0], quat[:, 0], pos[:, -1], quat[:, -1]
         hand_link = next(l for l in robot.links if l.name == "hand_frame")
         v_w, w_w = hand_link.get_linear_velocity(), hand_link.get_angular_velocity()
         inv = quat_inv(hand_q)
         q, qd = robot.get_qpos().clone(), robot.get_qvel().clone()
-        wrist = self._qidx[:6]
-        q[:, wrist] = 0.0
+        rows, wrist = env_idx[:, None], self._qidx[:6]
+        q[rows, wrist] = 0.0
         # at zero Euler angles the wrist rates are the hand's velocities in the new root frame
-        qd[:, wrist] = torch.cat([quat_apply(inv, v_w), quat_apply(inv, w_w)], dim=-1)
-        robot.set_root_pose(Pose.create_from_pq(hand_p, hand_q))
+        qd[rows, wrist] = torch.cat([quat_apply(inv, v_w), quat_apply(inv, w_w)], dim=-1)[env_idx]
+        root_p, root_q = robot.pose.p.clone(), robot.pose.q.clone()
+        root_p[env_idx], root_q[env_idx] = hand_p[env_idx], hand_q[env_idx]
+        robot.set_root_pose(Pose.create_from_pq(root_p, root_q))
         robot.set_qpos(q)
         robot.set_qvel(qd)
         if self.gpu_sim_enabled:
             self.scene._gpu_apply_all()
             self.scene.px.gpu_update_articulation_kinematics()
             self.scene._gpu_fetch_all()
-        self.command[:, :6] = 0.0
+        self.command[env_idx, :6] = 0.0
         self._apply_command()
         # task state of the new phase
-        self.phase = k
-        self.mode[:] = F.MODES.index(self.sequence[k])
-        every = torch.ones(n, dtype=torch.bool, device=dev)
-        self.reset_task_state(torch.arange(n, device=dev), hand_p, hand_q, obj_p, obj_q,
-                              robot.get_qpos()[:, self._qidx[6:]].clone(), relocate_goal=every)
-        self.static_skill = F.mode_skill(self.sequence[k])
+        self.phase[env_idx] += 1
+        self.mode[env_idx] = self._phase_mode[self.phase[env_idx]]
+        every = torch.ones(len(env_idx), dtype=torch.bool, device=self.device)
+        self.reset_task_state(env_idx, hand_p[env_idx], hand_q[env_idx], obj_p[env_idx], obj_q[env_idx],
+                              robot.get_qpos()[env_idx][:, self._qidx[6:]].clone(), relocate_goal=every)
+        self._set_static_skill()
         self._stepped = False

@@ -11,53 +11,71 @@ from typing import Any, Dict
 import torch
 from mani_skill.utils import common
 
+from tensordict import TensorDict
+
 from unicross import formulation as F
 
 
+def _flat(v):
+    return v.flat() if isinstance(v, F.Relational) else v
+
+
+def _column(v: torch.Tensor) -> torch.Tensor:
+    """A task-state entry as ManiSkill's flat state vector holds it: float, [N, k], a copy (the live
+    tensors change in place: a state that aliased them would follow the episode it was taken from)."""
+    v = v.float().clone()
+    return v[:, None] if v.ndim == 1 else v
+
+
 class TaskStateIO:
-    """Task-state save and restore of the UniCross task (a mixin of ``UniCrossEnv``)."""
+    """Task-state save and restore of the UniCross task (a mixin of ``UniCrossEnv``).
 
-    _TASK_STATE = ("root_p", "root_q", "init_rel", "targets", "prev_rel", "final_x_or", "final_q_or", "axis",
-                   "command", "finger_q0", "rot_acc", "trans_acc", "ever_dropped", "obj_z0", "lift", "perturb",
-                   "obs_noise", "obj_vel_h", "obj_angvel_h", "hand_vel", "hand_angvel", "link_force", "disturb", "mode")
+    ``TASK_STATE`` names every per-env tensor the next observation and reward depend on beyond the
+    simulator's state; a subclass with more state extends it (the chain env adds its phase).
+    :meth:`task_state` is that state as one TensorDict (batch [N]); ManiSkill's state dict stores it
+    under ``"task"`` as float columns (its flat state vector concatenates them)."""
 
-    def _task_state(self) -> Dict[str, torch.Tensor]:
-        out = {}
-        for k in self._TASK_STATE:
-            v = getattr(self, k)
-            if isinstance(v, F.Relational):
-                v = v.flat()
-            v = v.float()
-            out[k] = v[:, None] if v.ndim == 1 else v
-        return out
+    TASK_STATE = ("root_p", "root_q", "init_rel", "targets", "prev_rel", "final_x_or", "final_q_or", "axis",
+                  "command", "finger_q0", "rot_acc", "trans_acc", "ever_dropped", "obj_z0", "lift", "perturb",
+                  "obs_noise", "obj_vel_h", "obj_angvel_h", "hand_vel", "hand_angvel", "link_force", "disturb", "mode")
+
+    def task_state(self) -> TensorDict:
+        """The task state (``TASK_STATE``) as one TensorDict of batch [N], in its own dtypes; relational
+        poses as their 21 numbers (``Relational.flat``)."""
+        return TensorDict({k: _flat(getattr(self, k)) for k in self.TASK_STATE}, batch_size=[self.num_envs])
+
+    def load_task_state(self, task, env_idx: torch.Tensor = None) -> None:
+        """Writes ``task`` (a TensorDict or dict of [N, ...] tensors, e.g. :meth:`task_state` or the
+        ``"task"`` entry of a state dict) into the task state of envs ``env_idx`` (all if None)."""
+        idx = slice(None) if env_idx is None else env_idx
+        for k in self.TASK_STATE:
+            cur = getattr(self, k)
+            flat = _flat(cur)
+            v = common.to_tensor(task[k], device=self.device)
+            flat[idx] = v.reshape(v.shape[0], *flat.shape[1:]).to(flat.dtype)
+            if isinstance(cur, F.Relational):
+                setattr(self, k, F.Relational.unflat(flat).clone())
 
     def get_state_dict(self):
         state = super().get_state_dict()
-        state["task"] = self._task_state()
+        state["task"] = {k: _column(v) for k, v in self.task_state().items()}
         return state
 
     def set_state_dict(self, state: dict, env_idx: torch.Tensor = None):
         super().set_state_dict(state, env_idx)
-        task = state.get("task")
-        if task is None:
+        if state.get("task") is None:
             return
-        idx = slice(None) if env_idx is None else env_idx
-        for k in self._TASK_STATE:
-            cur = getattr(self, k)
-            v = common.to_tensor(task[k], device=self.device)
-            if isinstance(cur, F.Relational):
-                flat = cur.flat()
-                flat[idx] = v
-                setattr(self, k, F.Relational.unflat(flat).clone())
-            else:
-                v = v.reshape(v.shape[0], *cur.shape[1:]).to(cur.dtype)
-                cur[idx] = v
+        self.load_task_state(state["task"], env_idx)
         self._apply_command()
-        self._pending[idx] = False
+        self._pending[slice(None) if env_idx is None else env_idx] = False
         # the observation reflects the restored state
         self.evaluate()
 
     def set_state(self, state, env_idx: torch.Tensor = None):
+        """ManiSkill's flat-vector ``set_state`` with the task state: ManiSkill 3.0.1 rebuilds only the
+        actors and articulations from a vector, dropping every other key of ``get_state()``; this
+        reads the ``"task"`` columns too (when the vector has them) and accepts one unbatched state
+        (``replay_trajectory --use-env-states`` passes those)."""
         state = common.to_tensor(state, device=self.device)
         if state.ndim == 1:
             state = state[None]
@@ -70,9 +88,10 @@ class TaskStateIO:
             sd["articulations"][k] = state[:, start:start + v.shape[-1]]
             start += v.shape[-1]
         task = {}
-        for k, v in self._task_state().items():
-            task[k] = state[:, start:start + v.shape[-1]]
-            start += v.shape[-1]
+        for k, v in self.task_state().items():
+            width = _column(v).shape[-1]
+            task[k] = state[:, start:start + width]
+            start += width
         if start == state.shape[-1]:
             sd["task"] = task
         self.set_state_dict(sd, env_idx)

@@ -85,3 +85,23 @@ def test_chain_command_runs_a_policy_and_writes_every_trial(tmp_path):
     r = json.loads(out.read_text())
     assert r["policy"]["kind"] == "zero" and len(r["trials"]) >= 1
     assert all(len(t["phase_success"]) == 2 for t in r["trials"])
+
+
+def test_chain_state_round_trip_keeps_the_phase():
+    """The phase and phase successes are task state: restoring a state taken in the second phase
+    after the episode moved on to the third brings the phase and mode back."""
+    env = make("UniCross-Chain-v1", objects="test-wrappable", sequence="grasp,relocate,rotate:y-",
+               phase_steps=dict(grasp=3, relocate=3, rotate=3), randomize=False)
+    u = env.unwrapped
+    env.reset(seed=1)
+    for _ in range(4):
+        env.step(torch.zeros(22))
+    assert u.phase.tolist() == [1] and u.mode.item() == F.MODES.index("relocate")
+    state, obs = u.get_state_dict(), u.get_obs()
+    for _ in range(3):
+        _, _, _, _, info = env.step(torch.zeros(22))
+    assert info["phase"].tolist() == [2]
+    u.set_state_dict(state)
+    assert u.phase.tolist() == [1] and u.mode.item() == F.MODES.index("relocate")
+    assert torch.allclose(u.get_obs(), obs, atol=1e-5)
+    env.close()

@@ -88,6 +88,13 @@ def test_state_round_trip(task, kw, grasp_file):
     # the dict form too, and stepping on from the restored state reproduces the next obs
     u.set_state_dict(u.get_state_dict())
     assert torch.allclose(u.get_obs(), saved_obs, atol=1e-5)
+    # the task state is one TensorDict of batch [N], in its own dtypes, loadable as it is
+    td = u.task_state()
+    assert td.batch_size == torch.Size([1]) and set(td.keys()) == set(u.TASK_STATE)
+    assert td["ever_dropped"].dtype == torch.bool and td["targets"].shape == (1, 21)
+    env.step(torch.zeros(22))
+    u.load_task_state(td)
+    assert torch.equal(u.task_state()["targets"], td["targets"])
     env.close()
 
 

@@ -378,9 +378,9 @@ def run_chain(policy: PolicyFn, objects: Sequence[ObjectSpec], sequence: Optiona
             for t in range(u.phase_ends[-1]):
                 obs, _, term, trunc, info = u.step(policy(obs, u))
                 if rec is not None:
-                    rec.record(f"phase {u.phase + 1}/{len(modes)}")
+                    rec.record(f"phase {int(u.phase[0]) + 1}/{len(modes)}")
                 if bool(term.all()):
-                    phase_of_drop = u.phase
+                    phase_of_drop = int(u.phase[0])
                     break
             ps = u.phase_success[0].tolist()
             trials.append(dict(object=obj.name, category=obj.category, sequence=modes, trial=k, seed=trial_seed,
