@@ -35,6 +35,7 @@ from unicross.compiling import compile_enabled, maybe_compile
 from unicross.config import load_config
 from unicross.grasps import GraspSet, default_grasp_path
 from unicross.objects import resolve_objects
+from unicross.observations import observe, resolve as resolve_observation
 from unicross.robots.hand import HandSpec, load_hand, register_hand_agent
 from unicross.tasks.scene import TaskScene
 from unicross.tasks.starts import EpisodeStarts
@@ -115,6 +116,7 @@ class UniCrossEnv(TaskScene, EpisodeStarts, StepMath, TaskStateIO, BaseEnv):
         if randomize is not None:
             self.cfg["randomization"]["enabled"] = bool(randomize)
         self.reward_cfg = load_config("reward", reward_config)
+        self._obs_terms = resolve_observation(self.cfg["observation"])
         modes = tuple(modes or self.DEFAULT_MODES)
         bad = [m for m in modes if m not in F.MODES]
         if bad:
@@ -341,9 +343,7 @@ class UniCrossEnv(TaskScene, EpisodeStarts, StepMath, TaskStateIO, BaseEnv):
         return dict()
 
     def _get_obs_extra(self, info: dict):
-        p = self._obs_parts
-        hand = torch.cat([p["qpos"] + self.obs_noise, self.command], dim=-1)
-        return dict(hand=hand, object=dict(contact=p["contact"], force=p["force"], distance=p["distance"]), goal=p["goal"])
+        return observe(self, self._obs_terms)
 
     # ------------------------------------------------------------------ reward
     def compute_dense_reward(self, obs: Any, action: torch.Tensor, info: dict):

@@ -92,3 +92,27 @@ def test_every_skill_names_a_registered_success_test():
         assert S.get(s.success) is S.SUCCESS_TESTS[s.success]
     with pytest.raises(ValueError, match="registered"):
         S.get("no_such_test")
+
+
+def test_a_new_observation_term_is_one_function_and_one_config_line(monkeypatch):
+    """A throwaway term named in the config's object group reaches the observation, the RL env's
+    spec and the policy's input sizes; unknown terms are refused before any simulation."""
+    import gymnasium as gym
+    from unicross import observations as O
+    from unicross.rl.env import ManiSkillEnv
+
+    monkeypatch.setattr(O, "OBSERVATION_TERMS", dict(O.OBSERVATION_TERMS))
+    O.observation_term("object_speed")(lambda env: torch.linalg.norm(env.obj_vel_h, dim=-1, keepdim=True))
+    layout = dict(hand=["joint_pos", "command"], object=["contact", "force", "distance", "object_speed"], goal=["goal"])
+    kw = dict(object_limit=1, config=dict(observation=layout))
+    env = gym.make("UniCross-Grasp-v1", obs_mode="state_dict", sim_backend="physx_cpu", render_backend="none", **kw)
+    obs, _ = env.reset(seed=0)
+    assert list(obs["extra"]["object"]) == layout["object"] and obs["extra"]["object"]["object_speed"].shape == (1, 1)
+    env.close()
+    plain = ManiSkillEnv("UniCross-Grasp-v1", dict(object_limit=1))
+    tr = ManiSkillEnv("UniCross-Grasp-v1", kw)
+    assert tr.observation_spec["object"].shape[-1] == plain.observation_spec["object"].shape[-1] + 1
+    plain.close()
+    tr.close()
+    with pytest.raises(ValueError, match="unknown observation term"):
+        gym.make("UniCross-Grasp-v1", object_limit=1, config=dict(observation=dict(layout, goal=["nope"])))

@@ -33,7 +33,7 @@ def info_float_keys() -> tuple:
 def split_obs(obs: dict) -> tuple:
     """(hand, object, goal) tensors [N, d] of a UniCross ``state_dict`` observation."""
     o = obs["extra"]
-    obj = torch.cat([o["object"]["contact"], o["object"]["force"], o["object"]["distance"]], dim=-1)
+    obj = torch.cat(list(o["object"].values()), dim=-1)  # its terms in config order
     return o["hand"], obj, o["goal"]
 
 
