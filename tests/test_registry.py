@@ -116,3 +116,40 @@ def test_a_new_observation_term_is_one_function_and_one_config_line(monkeypatch)
     tr.close()
     with pytest.raises(ValueError, match="unknown observation term"):
         gym.make("UniCross-Grasp-v1", object_limit=1, config=dict(observation=dict(layout, goal=["nope"])))
+
+
+def test_a_new_axis_is_one_registry_entry(tmp_path):
+    """A throwaway third translate direction (x+), added to the registry entry alone (in a fresh
+    process, since the modes are fixed at import), gives an 11-mode formulation whose env runs."""
+    import subprocess
+    import sys
+    import textwrap
+    code = textwrap.dedent('''
+        import dataclasses, importlib.util, sys
+        # the registry module on its own, patched before the package (and its formulation) imports it
+        spec = importlib.util.spec_from_file_location("unicross.registry", REGISTRY_PATH)
+        R = importlib.util.module_from_spec(spec)
+        sys.modules["unicross.registry"] = R
+        spec.loader.exec_module(R)
+        skills = [dataclasses.replace(s, axes=s.axes + ("x+",)) if s.name == "translate" else s for s in R._SKILL_LIST]
+        R._SKILL_LIST = tuple(skills)
+        R.SKILLS = {s.name: s for s in skills}
+        R.MODES = tuple(m for s in skills for m in s.modes)
+        R.NUM_MODES = len(R.MODES)
+        import gymnasium as gym
+        import torch
+        import unicross
+        from unicross import formulation as F
+        assert F.NUM_MODES == 11 and F.GOAL_DIM == 11 + 3 + 42 and F.MODES[-1] == "translate_x+"
+        env = gym.make("UniCross-Translate-v1", obs_mode="state_dict", sim_backend="physx_cpu",
+                       render_backend="none", direction="x+", object_limit=2)
+        obs, _ = env.reset(seed=0)
+        obs, *_ = env.step(torch.zeros(1, env.unwrapped.hand_spec.dof))
+        goal = obs["extra"]["goal"][0]
+        assert goal.shape == (F.GOAL_DIM,) and goal[10] == 1 and torch.equal(goal[11:14], torch.tensor([1.0, 0, 0]))
+        print("ok")
+    ''')
+    code = code.replace("REGISTRY_PATH", repr(R.__file__))
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=600,
+                         env=dict(__import__("os").environ, UNICROSS_COMPILE="0"))
+    assert out.stdout.strip().endswith("ok"), out.stderr[-2000:]
