@@ -144,7 +144,8 @@ class UniCrossEnv(TaskScene, EpisodeStarts, StepMath, TaskStateIO, BaseEnv):
         skills = {F.mode_skill(m) for m in modes}
         self.static_skill = skills.pop() if len(skills) == 1 else None  # lets target updates skip other rules
         self.grasps: Optional[GraspSet] = None
-        if any(F.mode_skill(m) != "grasp" for m in modes):
+        in_hand = lambda mode: not R.skill_of_mode(mode).starts_on_table  # noqa: E731  (starts from a grasp)
+        if any(in_hand(m) for m in modes):
             if isinstance(grasp_dataset, GraspSet):
                 path, self.grasps = "<in memory>", grasp_dataset
             else:
@@ -153,7 +154,7 @@ class UniCrossEnv(TaskScene, EpisodeStarts, StepMath, TaskStateIO, BaseEnv):
             if self.grasps.hand != self.hand_spec.name:
                 raise ValueError(f"grasp dataset {path} is for hand {self.grasps.hand!r}, not {self.hand_spec.name!r}")
             have = {n for n, c in self.grasps.counts().items() if c > 0}
-            needed = {self.object_names[oi] for oi, mi in self._pairs if F.mode_skill(F.MODES[mi]) != "grasp"}
+            needed = {self.object_names[oi] for oi, mi in self._pairs if in_hand(F.MODES[mi])}
             missing = sorted(needed - have)
             if missing and len(missing) == len(needed):
                 raise ValueError(f"grasp dataset {path} has no grasps for the {len(missing)} object(s) of "
@@ -162,7 +163,7 @@ class UniCrossEnv(TaskScene, EpisodeStarts, StepMath, TaskStateIO, BaseEnv):
                 logger.warning(f"{len(missing)} object(s) have no grasp in {path} and are left out of the "
                                f"in-hand modes, e.g. {missing[:3]}")
                 self._pairs = [(oi, mi) for oi, mi in self._pairs
-                               if F.mode_skill(F.MODES[mi]) == "grasp" or self.object_names[oi] in have]
+                               if not in_hand(F.MODES[mi]) or self.object_names[oi] in have]
         register_hand_agent(self.hand_spec)
         super().__init__(*args, robot_uids=self.hand_spec.uid, **kwargs)
         n = self.hand_spec.dof
@@ -180,12 +181,10 @@ class UniCrossEnv(TaskScene, EpisodeStarts, StepMath, TaskStateIO, BaseEnv):
         if self._seeded_reset and options.get("seed_generator", True):
             self._gen.manual_seed(int(self._episode_seed[0]))
         g = self._gen
-        skill = F.MODE_SKILL_ID.to(dev)[self.mode[env_idx]]
         hand_p, hand_q, obj_p, obj_q, fq = self._grasp_start(env_idx)
         ft, mq = fq, None  # finger targets; recorded coupled-joint positions of a restored grasp
         if self.grasps is not None:
-            hand_p, hand_q, obj_p, obj_q, fq, ft, mq = self._in_hand_start(env_idx, skill, hand_p, hand_q,
-                                                                          obj_p, obj_q, fq)
+            hand_p, hand_q, obj_p, obj_q, fq, ft, mq = self._in_hand_start(env_idx, hand_p, hand_q, obj_p, obj_q, fq)
         # ---- apply to the simulation
         qpos = torch.zeros(b, spec.dof, device=dev)
         qpos[:, 6:] = fq
@@ -197,7 +196,7 @@ class UniCrossEnv(TaskScene, EpisodeStarts, StepMath, TaskStateIO, BaseEnv):
         self.agent.robot.set_root_pose(Pose.create_from_pq(hand_p, hand_q))
         self.obj.set_pose(Pose.create_from_pq(obj_p, obj_q))
         # ---- task state
-        self.reset_task_state(env_idx, hand_p, hand_q, obj_p, obj_q, fq, skill == F.skill_id("relocate"))
+        self.reset_task_state(env_idx, hand_p, hand_q, obj_p, obj_q, fq, self._draws_goal_pose[self.mode[env_idx]])
         cmd = torch.zeros(b, spec.dof, device=dev)
         cmd[:, 6:] = ft
         self.command[env_idx] = cmd
@@ -306,7 +305,7 @@ class UniCrossEnv(TaskScene, EpisodeStarts, StepMath, TaskStateIO, BaseEnv):
             active = torch.ones(n, 1, dtype=torch.bool, device=self.device)
             lift_after = self.cfg["grasp"]["lift_after"]
             if lift_after is not None:
-                active = ((self.mode != F.mode_index("grasp")) | (self.elapsed_steps >= lift_after))[:, None]
+                active = (~self._lifts[self.mode] | (self.elapsed_steps >= lift_after))[:, None]
             disturb = torch.where(active, self.disturb, torch.zeros_like(self.disturb))
             forces = disturb.expand(k, n, 3) if forces is None else forces + disturb
         if forces is not None:

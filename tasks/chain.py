@@ -39,8 +39,9 @@ def parse_sequence(seq: str | Sequence[str]) -> List[str]:
             continue
         skill, _, axis = it.partition(":")
         modes.append(F.MODES[F.mode_index(skill, axis or None)])
-    if not modes or modes[0] != "grasp":
-        raise ValueError(f"a chain starts with grasp (from the table), got {items}")
+    if not modes or not skill_of_mode(modes[0]).starts_on_table:
+        starters = [s.name for s in SKILLS.values() if s.starts_on_table]
+        raise ValueError(f"a chain starts with a skill that starts from the table ({starters}), got {items}")
     return modes
 
 
@@ -58,7 +59,7 @@ class ChainEnv(UniCrossEnv):
         cats = set.intersection(*(set(skill_of_mode(m).categories) for m in self.sequence))
         self._chain_categories = cats
         cfg = dict(kwargs.pop("config", None) or {})
-        cfg.setdefault("episode_length", {})["grasp"] = self.phase_ends[-1]
+        cfg.setdefault("episode_length", {})[F.mode_skill(self.sequence[0])] = self.phase_ends[-1]
         objects = kwargs.pop("objects", None) or self.DEFAULT_OBJECTS
         limit = kwargs.pop("object_limit", None)
         objs = get_object_set(objects, limit=limit) if isinstance(objects, str) else resolve_objects(objects)
@@ -66,7 +67,7 @@ class ChainEnv(UniCrossEnv):
         if not objs:
             raise ValueError(f"no object of the set can do every phase of {self.sequence} "
                              f"(rotate needs wrappable objects, translate elongated ones)")
-        super().__init__(*args, modes=("grasp",), objects=objs, config=cfg, **kwargs)
+        super().__init__(*args, modes=(self.sequence[0],), objects=objs, config=cfg, **kwargs)
 
     TASK_STATE = UniCrossEnv.TASK_STATE + ("phase", "phase_success")
 

@@ -140,6 +140,13 @@ class TaskScene:
         self._drive_idx = torch.cat([self._qidx, self._midx])
         self.episode_length = torch.tensor([self.cfg["episode_length"][F.mode_skill(m)] for m in F.MODES], device=dev)
         self.rewards = RewardTerms(self.reward_cfg, dev, self.cfg["ablation"]["no_track_reward"])
+        # per-mode flags of the registry (how each skill's episodes run), indexed by self.mode
+        self._starts_on_table = F.mode_flag("starts_on_table").to(dev)
+        self._wrist_where_grasped = F.mode_flag("wrist_where_grasped").to(dev)
+        self._lifts = F.mode_flag("lifts").to(dev)
+        self._draws_goal_pose = F.mode_flag("draws_goal_pose").to(dev)
+        self._accumulates_rotation = F.mode_flag("accumulates", "rotation").to(dev)
+        self._accumulates_translation = F.mode_flag("accumulates", "translation").to(dev)
         self._success_tests = [success_test(s.success) for s in R.SKILLS.values()]  # in skill order
         self.motion = F.MotionParams(dt=self.control_dt, **self.cfg["motion"])
         self._speed_cap = torch.tensor([self.cfg["motion"][R.skill_of_mode(m).speed] for m in F.MODES], device=dev)

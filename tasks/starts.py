@@ -58,10 +58,10 @@ class EpisodeStarts:
         init_pose = torch.stack([torch.tensor(spec.init_finger_qpos(c), device=dev) for c in ("wrappable", "elongated")])
         return hand_p_grasp, hand_q_grasp, obj_p_table, obj_q_table, init_pose[cat]
 
-    def _in_hand_start(self, env_idx, skill, hand_p, hand_q, obj_p, obj_q, fq):
-        """In-hand start (relocate / rotate / translate; grasp envs keep the given start): a grasp
-        state from the dataset, with the wrist where it was grasped for relocate and at
-        ``in_hand_start_height`` in a random (or palm-up) orientation for rotate and translate.
+    def _in_hand_start(self, env_idx, hand_p, hand_q, obj_p, obj_q, fq):
+        """In-hand start (envs whose skill does not start on the table keep the given start): a grasp
+        state from the dataset, with the wrist where it was grasped (``Skill.wrist_where_grasped``,
+        relocate) or at ``in_hand_start_height`` in a random (or palm-up) orientation (rotate, translate).
         Returns hand and object poses, finger positions and targets, and the recorded coupled-joint
         positions (``(is_grasp, mimic_qpos)`` or None)."""
         dev, g, b = self.device, self._gen, len(env_idx)
@@ -72,12 +72,12 @@ class EpisodeStarts:
             xu = torch.tensor([0.0, 0.0, 1.0], device=dev).expand(b, 3)
             zu = torch.stack([torch.cos(psi), torch.sin(psi), torch.zeros_like(psi)], -1)
             random_q = quat_from_matrix(torch.stack([xu, torch.cross(zu, xu, dim=-1), zu], dim=-1))
-        is_reloc = (skill == F.skill_id("relocate"))[:, None]
+        is_reloc = self._wrist_where_grasped[self.mode[env_idx]][:, None]
         world_q = torch.where(is_reloc, gs["wrist_pose"][:, 3:], random_q)
         inhand_p = torch.tensor([0.0, 0.0, self.cfg["in_hand_start_height"]], device=dev).expand(b, 3)
         world_p = torch.where(is_reloc, gs["wrist_pose"][:, :3], inhand_p)
         op, oq = pose_mul(world_p, world_q, gs["object_pose_hand"][:, :3], gs["object_pose_hand"][:, 3:])
-        is_grasp = (skill == F.skill_id("grasp"))[:, None]
+        is_grasp = self._starts_on_table[self.mode[env_idx]][:, None]
         mq = None
         if "mimic_qpos" in gs.keys() and gs["mimic_qpos"].shape[-1] == len(self._midx) > 0:
             mq = (is_grasp, gs["mimic_qpos"])

@@ -13,6 +13,7 @@ from typing import Dict
 import torch
 
 from unicross import formulation as F
+from unicross import registry as R
 from unicross.geometry import (
     closest_point_shapes, pose_mul, quat_apply,
     quat_angle, quat_inv,
@@ -38,9 +39,9 @@ class StepMath:
         ``lift_speed * dt`` per step after ``lift_after`` steps; ``self.lift`` accumulates the rise,
         which the Fixed object target follows. Returns this step's increment (root frame)."""
         lift_after = self.cfg["grasp"]["lift_after"]
-        if lift_after is None or self.static_skill not in (None, "grasp"):
+        if lift_after is None or (self.static_skill is not None and not R.skill(self.static_skill).lifts):
             return torch.zeros_like(self.lift)
-        lifting = (self.mode == F.mode_index("grasp")) & (elapsed_steps >= lift_after)
+        lifting = self._lifts[self.mode] & (elapsed_steps >= lift_after)
         up_root = quat_apply(quat_inv(self.root_q), self._world_up.expand_as(self.lift))
         step = lifting[:, None].float() * up_root * self.cfg["grasp"]["lift_speed"] * self.control_dt
         self.lift = self.lift + step
@@ -76,15 +77,15 @@ class StepMath:
         skill = F.MODE_SKILL_ID.to(self.device)[self.mode]
         axis_prev = self.axis
         goal_err_prev, goal_err = self._goal_errors(cur)
-        self._advance_motion(cur, pend, skill, axis_prev)
+        self._advance_motion(cur, pend, axis_prev)
         # reward compares against the targets the last action aimed at; Free targets = current
         reward_targets = F.with_free_as_current(self.mode, self.targets, cur)
-        drop = self._drop(m["link_distance"], skill, elapsed_steps)
+        drop = self._drop(m["link_distance"], elapsed_steps)
         self._advance_targets(cur, pend)
         success, contact, lifted, pos_err, rot_err = self._success(m, skill)
         force_c = m["force"].clamp(max=self.cfg["force_clip"])
         # motion along the axis the last action was asked to follow
-        is_rot = skill == F.skill_id("rotate")
+        is_rot = self._accumulates_rotation[self.mode]
         speed = torch.where(is_rot, (self.obj_angvel_h * axis_prev).sum(-1), (self.obj_vel_h * axis_prev).sum(-1))
         meas = dict(link_distance=m["link_distance"], contact=contact, force_clipped=force_c, speed_along_axis=speed,
                     speed_cap=self._speed_cap[self.mode], relational=cur, reward_targets=reward_targets,
@@ -110,7 +111,7 @@ class StepMath:
                              quat_angle(cur.q_or, self.final_q_or)], dim=-1)
         return before, after
 
-    def _advance_motion(self, cur: F.Relational, pend, skill, axis_prev):
+    def _advance_motion(self, cur: F.Relational, pend, axis_prev):
         """Velocities over the last control step (object in the hand frame, hand in the root frame)
         and the rotation / translation accumulated along the mode's axis, once per control step."""
         dt = self.control_dt
@@ -122,18 +123,17 @@ class StepMath:
         self.obj_angvel_h = torch.where(p1, w, self.obj_angvel_h)
         self.hand_vel = torch.where(p1, hv, self.hand_vel)
         self.hand_angvel = torch.where(p1, hw, self.hand_angvel)
-        is_rot = skill == F.skill_id("rotate")
-        is_trans = skill == F.skill_id("translate")
+        is_rot, is_trans = self._accumulates_rotation[self.mode], self._accumulates_translation[self.mode]
         self.rot_acc = self.rot_acc + (pend & is_rot).float() * (w * axis_prev).sum(-1) * dt
         self.trans_acc = self.trans_acc + (pend & is_trans).float() * (v * axis_prev).sum(-1) * dt
 
-    def _drop(self, dist, skill, elapsed_steps):
+    def _drop(self, dist, elapsed_steps):
         """Drop (DESIGN §6): every link farther than ``drop_threshold`` from the object; a grasp can
         only drop what it lifted (before the lift phase the object rests on the table)."""
         drop = dist.min(dim=-1).values > self.cfg["drop_threshold"]
         lift_after = self.cfg["grasp"]["lift_after"]
         grasp_lifting = (elapsed_steps >= lift_after) if lift_after is not None else torch.zeros_like(drop)
-        drop = drop & ((skill != F.skill_id("grasp")) | grasp_lifting)
+        drop = drop & (~self._lifts[self.mode] | grasp_lifting)
         self.ever_dropped = self.ever_dropped | drop
         return drop
 

@@ -12,7 +12,7 @@ def test_sequence_parsing():
     assert parse_sequence("grasp,relocate,rotate:x+") == ["grasp", "relocate", "rotate_x+"]
     with pytest.raises(ValueError, match="valid axes"):
         parse_sequence("grasp,rotate:w+")
-    with pytest.raises(ValueError, match="starts with grasp"):
+    with pytest.raises(ValueError, match="starts from the table"):
         parse_sequence("relocate,rotate:x+")
 
 

@@ -67,6 +67,11 @@ def skill_id(name: str) -> int:
     return SKILLS.index(R.skill(name).name)
 
 
+def mode_flag(attr: str, value=True) -> torch.Tensor:
+    """Per mode [NUM_MODES] bool: whether its skill's registry field ``attr`` equals ``value``."""
+    return torch.tensor([getattr(R.skill_of_mode(m), attr) == value for m in MODES])
+
+
 MODE_AXES = torch.tensor([R.axis_vector(R.mode_axis(m)) for m in MODES])
 MODE_SKILL_ID = torch.tensor([SKILLS.index(mode_skill(m)) for m in MODES])
 

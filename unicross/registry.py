@@ -37,6 +37,13 @@ class Skill:
     protocol_steps: int = 75          # control steps of its evaluation protocol (paper §4.2)
     speed: str = "v_max"              # configs/task.yaml motion key capping its r_motion (v_max, omega_max)
     success_once: bool = False        # success counts when reached at any step (accumulated motion), not at the end
+    # how its episodes run (tasks/ reads these flags; none of it names a skill)
+    starts_on_table: bool = False     # starts with the object on the table (else from a grasp state of the dataset)
+    wrist_where_grasped: bool = False  # in-hand start with the wrist where the grasp was recorded (else in the air)
+    lifts: bool = False               # a lift phase after grasp.lift_after: the wrist reference rises, and drops
+                                      # (and the robustness disturbance) count only while lifting
+    draws_goal_pose: bool = False     # draws a final object pose at its start (configs/task.yaml relocate_target)
+    accumulates: Optional[str] = None  # motion accumulated along its axis: "rotation" or "translation"
 
     @property
     def modes(self) -> Tuple[str, ...]:
@@ -64,22 +71,23 @@ class Skill:
 _SKILL_LIST = (
     Skill("grasp", "UniCross-Grasp-v1", "Gr.",
           targets=dict(x_oh="palm", q_oh="free", x_or="fixed", q_or="fixed", x_hr="free", q_hr="free"),
-          success="lifted_with_contacts"),
+          success="lifted_with_contacts", starts_on_table=True, lifts=True),
     Skill("relocate", "UniCross-Relocate-v1", "Re.",
           targets=dict(x_oh="fixed", q_oh="fixed", x_or="interpolate", q_or="interpolate",
                        x_hr="hand_from_object", q_hr="hand_from_object"),
-          success="at_final_pose"),
+          success="at_final_pose", wrist_where_grasped=True, draws_goal_pose=True),
     Skill("rotate", "UniCross-Rotate-v1", "Rot.",
           targets=dict(x_oh="fixed", q_oh="rotate_about_axis", x_or="fixed", q_or="object_from_hand",
                        x_hr="fixed", q_hr="fixed"), success="rotated_past_threshold",
           axes=("x+", "x-", "y+", "y-", "z+", "z-"), axis_kwarg="axis", categories=("wrappable",),
           train_objects="train-wrappable", ppo_horizon=8, protocol_steps=400, speed="omega_max",
-          success_once=True),
+          success_once=True, accumulates="rotation"),
     Skill("translate", "UniCross-Translate-v1", "Trans.",
           targets=dict(x_oh="translate_along_axis", q_oh="fixed", x_or="object_from_hand", q_or="fixed",
                        x_hr="fixed", q_hr="fixed"), success="translated_past_threshold",
           axes=("z+", "z-"), axis_kwarg="direction", categories=("elongated",),
-          train_objects="train-elongated", ppo_horizon=8, protocol_steps=50, success_once=True),
+          train_objects="train-elongated", ppo_horizon=8, protocol_steps=50, success_once=True,
+          accumulates="translation"),
 )
 
 SKILLS: Dict[str, Skill] = {s.name: s for s in _SKILL_LIST}
