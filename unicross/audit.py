@@ -37,6 +37,7 @@ import gymnasium as gym
 import torch
 
 from unicross import formulation as F
+from unicross.seeding import trial_seed
 from unicross.config import load_config
 
 from unicross.rewards import term_names
@@ -185,7 +186,7 @@ def audit(skill: str = "grasp", axis: Optional[str] = None, objects: Optional[st
         length = int(u.episode_length[u.mode[0]])
         for name, make in beh.items():
             for k in range(seeds):
-                u.reset(seed=10_007 * oi + k)
+                u.reset(seed=trial_seed(0, oi, k))
                 act = make(u)
                 disc = 1.0
                 ret = {t: 0.0 for t in terms}

@@ -35,6 +35,7 @@ from tqdm import tqdm
 from unicross import formulation as F
 from unicross import metrics as M
 from unicross import registry as R
+from unicross.seeding import trial_seed
 from unicross.config import load_config
 from unicross.geometry import pose_inv, pose_mul, quat_to_euler_xyz
 from unicross.objects import ObjectSpec
@@ -64,7 +65,7 @@ def make_random_policy(seed: int) -> PolicyFn:
 
     def policy(obs, u):
         if int(u.elapsed_steps[0]) == 0:
-            g.manual_seed(seed * 1_000_003 + int(u._episode_seed[0]))
+            g.manual_seed(trial_seed(seed, trial=int(u._episode_seed[0])))
         return (torch.rand(u.num_envs, u.hand_spec.dof, generator=g) * 2 - 1).to(u.device)
     return policy
 
@@ -201,8 +202,8 @@ def run_protocol(protocol: str, policy: PolicyFn, objects: Sequence[ObjectSpec],
             u = env.unwrapped
             axis_vec = F.MODE_AXES[F.mode_index(protocol, axis)]
             for k in range(trials_per_object):
-                trial_seed = seed * 1_000_003 + oi * 10_007 + all_axes.index(axis) * 1009 + k
-                obs, info = u.reset(seed=trial_seed)
+                seed_k = trial_seed(seed, oi, k, axis=all_axes.index(axis))
+                obs, info = u.reset(seed=seed_k)
                 rec = None
                 if len(trials) < videos:
                     from unicross.trajectory import TrajectoryRecorder
@@ -227,7 +228,7 @@ def run_protocol(protocol: str, policy: PolicyFn, objects: Sequence[ObjectSpec],
                         break
                 if rec is not None:
                     _save_video(rec, video_dir, f"{protocol}_{obj.name}_{axis or 'na'}_{k}")
-                trials.append(_score(protocol, obj, axis, k, trial_seed, axis_vec.to(u.device),
+                trials.append(_score(protocol, obj, axis, k, seed_k, axis_vec.to(u.device),
                                      torch.stack(x_oh, 1), torch.stack(q_oh, 1), torch.stack(p_w, 1),
                                      torch.stack(q_w, 1), torch.stack(drop, 1), goal_p, goal_q, info, u))
                 bar.update(1)
@@ -367,8 +368,8 @@ def run_chain(policy: PolicyFn, objects: Sequence[ObjectSpec], sequence: Optiona
             env = gym.make("UniCross-Chain-v1", obs_mode="state_dict", sim_backend="physx_cpu", render_backend="none",
                            hand=hand, objects=[obj], randomize=randomize, sequence=modes)
             u = env.unwrapped
-            trial_seed = seed * 1_000_003 + oi * 10_007 + k
-            obs, info = u.reset(seed=trial_seed)
+            seed_k = trial_seed(seed, oi, k)
+            obs, info = u.reset(seed=seed_k)
             rec = None
             if len(trials) < videos:
                 from unicross.trajectory import TrajectoryRecorder
@@ -383,7 +384,7 @@ def run_chain(policy: PolicyFn, objects: Sequence[ObjectSpec], sequence: Optiona
                     phase_of_drop = int(u.phase[0])
                     break
             ps = u.phase_success[0].tolist()
-            trials.append(dict(object=obj.name, category=obj.category, sequence=modes, trial=k, seed=trial_seed,
+            trials.append(dict(object=obj.name, category=obj.category, sequence=modes, trial=k, seed=seed_k,
                                phase_success=ps, overall=all(ps), dropped_in_phase=phase_of_drop,
                                steps=int(u.elapsed_steps[0])))
             if rec is not None:

@@ -21,6 +21,7 @@ import gymnasium as gym
 import torch
 from tqdm import tqdm
 
+from unicross.seeding import GRASP_STRIDES, trial_seed
 from unicross.geometry import quat_apply, quat_inv
 from unicross.grasps import GraspSet, empty_rows, from_rows
 from unicross.objects import ObjectSpec
@@ -97,7 +98,7 @@ def synthesize(hand: str, objects: Sequence[ObjectSpec], per_object: int, seed: 
         u = env.unwrapped
         attempt = 0
         while kept[obj.name] < per_object and tried[obj.name] < max_tries:
-            u.reset(seed=seed * 100003 + oi * 1009 + attempt)
+            u.reset(seed=trial_seed(seed, oi, attempt, strides=GRASP_STRIDES))
             attempt += 1
             policy = ScriptedGrasp(u)
             info = None

@@ -12,6 +12,7 @@ from typing import Sequence
 import gymnasium as gym
 from tqdm import tqdm
 
+from unicross.seeding import GRASP_STRIDES, trial_seed
 from unicross.grasps import empty_rows, from_rows
 from unicross.objects import ObjectSpec
 from unicross.rl.policy_io import act, load_policy
@@ -36,7 +37,7 @@ def expert_grasps(ckpt_path, objects: Sequence[ObjectSpec], per_object: int, see
         length = int(u.episode_length[0])
         tried[obj.name] = kept[obj.name] = 0
         while kept[obj.name] < per_object and tried[obj.name] < max_tries:
-            obs, _ = u.reset(seed=seed * 100003 + oi * 1009 + tried[obj.name])
+            obs, _ = u.reset(seed=trial_seed(seed, oi, tried[obj.name], strides=GRASP_STRIDES))
             info = None
             for _ in range(length):
                 obs, _, term, _, info = u.step(act(policy, obs))
