@@ -105,6 +105,10 @@ class UniCrossEnv(TaskScene, EpisodeStarts, StepMath, TaskStateIO, BaseEnv):
                  config: Optional[dict] = None, reward_config: Optional[dict] = None,
                  randomize: Optional[bool] = None, robot_uids=None, **kwargs):
         # ---- validate everything before any simulation starts
+        if kwargs.get("control_mode") not in (None, "pd_joint_pos"):
+            raise ValueError(f"UniCross tasks have one control mode, 'pd_joint_pos' (normalised residual joint "
+                             f"targets, see formulation.map_action), not {kwargs['control_mode']!r}: pass "
+                             f"control_mode='pd_joint_pos' (ManiSkill's PPO baseline: --control_mode pd_joint_pos)")
         self._compiled = compile_enabled()  # UNICROSS_COMPILE (unicross/compiling.py), read once per env
         self._step_math = maybe_compile(self._step_math_eager) if self._compiled else self._step_math_eager
         self._command_math = maybe_compile(self._command_math_eager) if self._compiled else self._command_math_eager

@@ -4,8 +4,10 @@ from __future__ import annotations
 
 from unicross.tasks.registration import register_task
 
+from functools import partialmethod
+
 from unicross.config import load_config
-from unicross.registry import SKILLS
+from unicross.registry import SKILLS, Skill
 from unicross.tasks.base import UniCrossEnv
 
 EPISODE_STEPS = load_config("task")["episode_length"]  # the TimeLimit of each id; the task truncates by its config
@@ -56,3 +58,30 @@ class MultiSkillEnv(UniCrossEnv):
     at their mode's length."""
 
     DEFAULT_OBJECTS = "train"
+
+
+def axis_env_id(skill: Skill, axis: str) -> str:
+    """The id with ``axis`` fixed, for clients that cannot pass env kwargs (ManiSkill's PPO baseline):
+    ``UniCross-Rotate-v1`` + ``y-`` -> ``UniCross-RotateYNeg-v1`` (gymnasium ids allow no '+')."""
+    name, _, version = skill.env_id.rpartition("-")
+    return f"{name}{axis[0].upper()}{'Pos' if axis[1] == '+' else 'Neg'}-{version}"
+
+
+def _register_axis_ids() -> tuple:
+    """One id per mode of every skill with axes (``axis_env_id``), each a subclass of the skill's
+    class with the axis fixed."""
+    from mani_skill.utils.registration import REGISTERED_ENVS
+    ids = []
+    for s in SKILLS.values():
+        base = REGISTERED_ENVS[s.env_id].cls
+        for axis in s.axes:
+            uid = axis_env_id(s, axis)
+            cls = type(uid.replace("-", "_"), (base,), dict(
+                __init__=partialmethod(base.__init__, **{s.axis_kwarg: axis}),
+                __doc__=f"{base.__doc__.strip()} The {s.axis_kwarg} is fixed to {axis}."))
+            register_task(uid, max_episode_steps=EPISODE_STEPS[s.name])(cls)
+            ids.append(uid)
+    return tuple(ids)
+
+
+AXIS_TASK_IDS = _register_axis_ids()

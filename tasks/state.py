@@ -52,7 +52,7 @@ class TaskStateIO:
             cur = getattr(self, k)
             flat = _flat(cur)
             v = common.to_tensor(task[k], device=self.device)
-            flat[idx] = v.reshape(v.shape[0], *flat.shape[1:]).to(flat.dtype)
+            flat[idx] = v.reshape(-1, *flat.shape[1:]).to(flat.dtype)  # also unbatched states (replay tools)
             if isinstance(cur, F.Relational):
                 setattr(self, k, F.Relational.unflat(flat).clone())
 
@@ -68,8 +68,10 @@ class TaskStateIO:
         self.load_task_state(state["task"], env_idx)
         self._apply_command()
         self._pending[slice(None) if env_idx is None else env_idx] = False
-        # the observation reflects the restored state
-        self.evaluate()
+        # the observation reflects the restored state; no random draw (evaluate() would draw the
+        # observation noise), so the task generator's sequence stays the episode's and a replay by
+        # env states steps on as the recording did
+        self._step_math(*self._read(), self.elapsed_steps)
 
     def set_state(self, state, env_idx: torch.Tensor = None):
         """ManiSkill's flat-vector ``set_state`` with the task state: ManiSkill 3.0.1 rebuilds only the
