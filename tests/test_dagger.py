@@ -44,6 +44,14 @@ def test_refuses_to_start_without_every_expert(tmp_path, experts):
         expert_paths(tmp_path)
     with pytest.raises(ValueError, match="--experts"):
         DAggerTrainer(tmp_path / "run", None)
+    # every mode's folder needs that mode's expert: a grasp expert copied into rotate_x+ is refused
+    fake = tmp_path / "fake"
+    for m in F.MODES:
+        (fake / m).mkdir(parents=True)
+        src = experts / ("grasp" if m == "rotate_x+" else m) / "checkpoint.pt"
+        (fake / m / "checkpoint.pt").symlink_to(src)
+    with pytest.raises(ValueError, match="trained for mode 'grasp', not 'rotate_x\\+'"):
+        DAggerTrainer(tmp_path / "run2", fake, progress=False)
 
 
 def test_tiny_dagger_lowers_action_mse_on_every_mode(tmp_path, experts):
@@ -79,6 +87,11 @@ def test_dagger_resume(tmp_path, experts):
     opt = t.optim.state_dict()
     n = len(t.rb)
     t.close()
+    # the replay buffer sits in a directory the checkpoint names (written before it, atomically swapped)
+    ck = torch.load(tmp_path / "run" / "checkpoint.pt", weights_only=False)
+    assert ck["replay_dir"] == "replay-000002" and [p.name for p in (tmp_path / "run").glob("replay*")] == ["replay-000002"]
+    with pytest.raises(ValueError, match="unicross distill --resume"):
+        PPOTrainer(tmp_path / "run", resume=True, progress=False)
     r = DAggerTrainer(tmp_path / "run", resume=True, progress=False)
     assert r.epoch == 2 and len(r.rb) == n
     for k, s in opt["state"].items():

@@ -15,6 +15,8 @@ pytestmark = pytest.mark.unit
 class Counter(Runner):
     """The smallest trainer: one number, incremented by a random draw per step."""
 
+    STEP_KEY = "epoch"
+
     def __init__(self, run_dir, resume=False, overrides=None):
         super().__init__(run_dir, resume, overrides, "dagger", progress=False)
         self.value, self.steps = 0.0, 0
@@ -23,7 +25,7 @@ class Counter(Runner):
             self.load_runner_state(self.ckpt)
 
     def state(self):
-        return dict(**self.runner_state(), value=self.value, steps=self.steps, obs_dims=dict(goal=F.GOAL_DIM),
+        return dict(**self.runner_state(), value=self.value, steps=self.steps, epoch=self.steps, obs_dims=dict(goal=F.GOAL_DIM),
                     modes=list(F.MODES))
 
     def step(self):
@@ -48,6 +50,9 @@ def test_resume_continues_exactly_and_records_every_segment(tmp_path):
     first.save()
     with pytest.raises(FileExistsError, match="--resume"):
         Counter(tmp_path / "b")
+    with pytest.raises(RuntimeError, match="in use by another process"):  # one process per run directory
+        Counter(tmp_path / "b", resume=True)
+    first.release()
     second = Counter(tmp_path / "b", resume=True, overrides={"optim": {"lr": 1.0e-4}})
     assert second.cfg["optim"]["lr"] == 1.0e-4 and second.cfg["seed"] == first.cfg["seed"]
     for _ in range(3):

@@ -21,6 +21,7 @@ last one of an episode, before the reset), ``reward``, ``done``, ``terminated`` 
 from __future__ import annotations
 
 import math
+import signal
 import traceback
 from typing import Optional
 
@@ -118,6 +119,7 @@ def _worker(rank: int, env_id: str, env_kwargs: dict, seed: int, deterministic: 
     """Worker process: one env. Reports its sizes, receives the shared actor and buffer, then
     fills row ``rank`` of the buffer on every "collect"."""
     torch.set_num_threads(1)
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C reaches the whole group; the main process stops us
     try:
         rollout = Rollout(env_id, env_kwargs, seed, deterministic)
         conn.send(("ready", (rollout.dims, rollout.n_act)))

@@ -14,6 +14,8 @@ MSE and per-mode success rates are logged.
 """
 from __future__ import annotations
 
+import os
+import shutil
 import time
 from pathlib import Path
 from typing import Dict, Optional
@@ -25,6 +27,7 @@ from torchrl.envs.utils import ExplorationType, set_exploration_type
 from tqdm import tqdm
 
 from unicross import formulation as F
+from unicross import registry as R
 from unicross.rl.collector import LeanCollector
 from unicross.rl.models import OBS_KEYS, make_models
 from unicross.rl.policy_io import load_policy
@@ -51,6 +54,10 @@ class Teachers(torch.nn.Module):
         self.hand = None
         for m, p in paths.items():
             pol, ck = load_policy(p, device)
+            trained = R.skill(ck["skill"]).mode(ck.get("axis")) if ck.get("skill") in R.SKILLS else ck.get("skill")
+            if trained != m:
+                raise ValueError(f"expert {p} was trained for mode {trained!r}, not {m!r}: each mode's folder "
+                                 f"needs that mode's expert")
             self.n_act = ck["n_act"]
             if self.hand is None:
                 self.hand = ck["hand"]
@@ -75,11 +82,20 @@ class Teachers(torch.nn.Module):
 
 
 class DAggerTrainer(Runner):
+    STEP_KEY = "epoch"
+
     def __init__(self, run_dir, experts_dir=None, overrides: Optional[dict] = None, resume: bool = False,
                  progress: bool = True):
         if not resume and experts_dir is None:
             raise ValueError("--experts is required")
         super().__init__(run_dir, resume, overrides, "dagger", progress)
+        try:
+            self._build(experts_dir)
+        except BaseException:  # whatever failed, no worker is left behind and the directory is free
+            self.close()
+            raise
+
+    def _build(self, experts_dir):
         cfg = self.cfg
         if self.ckpt is not None:
             experts_dir = experts_dir or self.ckpt["experts_dir"]
@@ -124,18 +140,31 @@ class DAggerTrainer(Runner):
                     distilled_modes=list(self.teachers.modes), env_kwargs=self.env_kwargs)
 
     def save(self):
+        """The replay buffer goes to a new directory named by the epoch, then the checkpoint that
+        names it is written atomically, then older buffers are removed: a crash at any point leaves
+        a checkpoint and the buffer it names."""
         self.run_dir.mkdir(parents=True, exist_ok=True)
+        replay = None
         if len(self.rb):
-            self.rb.dumps(self.run_dir / "replay")
-        atomic_save(self.state(), self.run_dir / CKPT_NAME)
+            replay = f"replay-{self.epoch:06d}"
+            tmp = self.run_dir / f"{replay}.{os.getpid()}.tmp"
+            shutil.rmtree(tmp, ignore_errors=True)
+            self.rb.dumps(tmp)
+            shutil.rmtree(self.run_dir / replay, ignore_errors=True)
+            os.replace(tmp, self.run_dir / replay)
+        atomic_save(dict(self.state(), replay_dir=replay), self.run_dir / CKPT_NAME)
+        for old in self.run_dir.glob("replay*"):
+            if old.name != replay and old.is_dir():
+                shutil.rmtree(old, ignore_errors=True)
 
     def _load(self, ck):
         self.student.load_state_dict(ck["policy"])
         self.optim.load_state_dict(ck["optim"])
         self.epoch, self.frames = ck["epoch"], ck["frames"]
         self.load_runner_state(ck)
-        if (self.run_dir / "replay").exists():
-            self.rb.loads(self.run_dir / "replay")
+        replay = self.run_dir / ck.get("replay_dir", "replay")  # "replay": checkpoints before named buffers
+        if ck.get("replay_dir", "replay") and replay.exists():
+            self.rb.loads(replay)
 
     # ------------------------------------------------------------------ one epoch
     @torch.no_grad()
@@ -196,24 +225,35 @@ class DAggerTrainer(Runner):
         bar = tqdm(total=target, initial=self.epoch, desc="dagger", unit="epoch", disable=not self.progress)
         last = {}
         try:
-            while self.epoch < target:
-                t0 = time.perf_counter()
-                col = self.collect()
-                upd = self.update()
-                self.epoch += 1
-                last = dict(epoch=self.epoch, frames=self.frames, wall_s=self._wall(), buffer=len(self.rb),
-                            seconds=time.perf_counter() - t0, **upd, **col)
-                self.log_json(last)
-                self.log_scalars(last, self.frames)
-                if self.epoch % self.cfg["logging"]["checkpoint_every"] == 0:
-                    self.save()
-                bar.update(1)
-                bar.set_postfix(mse=f"{upd['mse']:.4f}")
+            with self.stop_on_signals():
+                last = self._epochs(target, bar)
+            self.save()  # not after an error: the last checkpoint stays as it was
         finally:
-            self.save()
             bar.close()
             self.close_logs()
         return last
 
+    def _epochs(self, target: int, bar) -> dict:
+        """Epochs (collect, label, update, log, periodic checkpoint) until ``target`` or a stop signal."""
+        last = {}
+        while self.epoch < target and self.stop_signal is None:
+            t0 = time.perf_counter()
+            col = self.collect()
+            upd = self.update()
+            self.epoch += 1
+            last = dict(epoch=self.epoch, frames=self.frames, wall_s=self._wall(), buffer=len(self.rb),
+                        seconds=time.perf_counter() - t0, **upd, **col)
+            self.log_json(last)
+            self.log_scalars(last, self.frames)
+            if self.epoch % self.cfg["logging"]["checkpoint_every"] == 0:
+                self.save()
+            bar.update(1)
+            bar.set_postfix(mse=f"{upd['mse']:.4f}")
+        return last
+
     def close(self):
-        self.collector.close()
+        try:
+            if getattr(self, "collector", None) is not None:
+                self.collector.close()
+        finally:
+            self.release()

@@ -95,12 +95,29 @@ def evaluation_shard(actor, skill: str, objects: str, limit, trials_per_object: 
 class PPOTrainer(Runner):
     """One expert: ``skill`` (+ ``axis`` for rotate/translate) on ``hand``."""
 
-    def __init__(self, run_dir, skill: str = "grasp", axis: Optional[str] = None, hand: str = "allegro",
+    def __init__(self, run_dir, skill: Optional[str] = None, axis: Optional[str] = None, hand: Optional[str] = None,
                  overrides: Optional[dict] = None, resume: bool = False, progress: bool = True):
+        if not resume:  # before the run directory is made
+            from unicross.robots.hand import load_hand
+            R.skill(skill or "grasp").mode(axis)
+            load_hand(hand or "allegro")
         super().__init__(run_dir, resume, overrides, "ppo", progress)
+        try:
+            self._build(skill, axis, hand, overrides)
+        except BaseException:  # whatever failed, no worker is left behind and the directory is free
+            self.close()
+            raise
+
+    def _build(self, skill, axis, hand, overrides):
         cfg = self.cfg
-        if self.ckpt is not None:
-            skill, axis, hand = self.ckpt["skill"], self.ckpt["axis"], self.ckpt["hand"]
+        if self.ckpt is not None:  # a resumed run keeps what it trains; a contradiction is refused
+            ck = dict(skill=self.ckpt["skill"], axis=self.ckpt["axis"], hand=self.ckpt["hand"])
+            asked = dict(skill=skill, axis=axis, hand=hand)
+            bad = [f"--{k} {v} (the run trains {ck[k]})" for k, v in asked.items() if v is not None and v != ck[k]]
+            if bad:
+                raise ValueError(f"cannot resume {self.run_dir} with {', '.join(bad)}: start a new run with another --out")
+            skill, axis, hand = ck["skill"], ck["axis"], ck["hand"]
+        skill, hand = skill or "grasp", hand or "allegro"
         from unicross.robots.hand import load_hand
         load_hand(hand)  # validates
         self.skill, self.axis, self.hand = skill, axis, hand
@@ -132,6 +149,12 @@ class PPOTrainer(Runner):
         self.dims = dims
         if self.ckpt is not None:
             self._load_state(self.ckpt)
+            lr = ((overrides or {}).get("optim") or {}).get("lr")
+            if lr is not None:  # the resumed optimiser carries its scheduled rate: the override replaces it
+                self.algo.lr = float(lr)
+                for g in self.algo.optim.param_groups:
+                    g["lr"] = self.algo.lr
+                print(f"[unicross] resumed with optim.lr={self.algo.lr:g} (the KL schedule goes on from there)")
         self.collector.set_actor(self.algo.actor)  # after loading: the workers share these weights
         self._ep_return = torch.zeros(num_envs, 1, device=self.device)
 
@@ -227,39 +250,14 @@ class PPOTrainer(Runner):
         if remaining == 0:
             return summary
         bar = tqdm(total=total, initial=self.frames, unit="frame", desc=f"ppo {self.skill}", disable=not self.progress)
-        t_last = time.perf_counter()
-        done_iters = 0
         try:
-            while self.frames < total:
-                data = self.collector.collect()
-                t_collect = time.perf_counter() - t_last
-                self.iteration += 1
-                self.frames += data.numel()
-                ep = self._episode_stats(data)
-                reward_raw = float(data["next", "reward"].mean())
-                ep["nonfinite"] = int(data["next", "info", "nonfinite"].sum())
-                t0 = time.perf_counter()
-                up = self.algo.update(data)
-                t_update = time.perf_counter() - t0
-                terms = {k: float(data["next", "info", k].mean()) for k in data["next", "info"].keys()
-                         if k.startswith("reward_")}
-                row = dict(iteration=self.iteration, frames=self.frames, wall_s=self._wall(), fps=data.numel() / max(t_collect + t_update, 1e-9),
-                           collect_s=t_collect, update_s=t_update, reward_raw=reward_raw,
-                           reward_scaled=reward_raw * self.cfg["gae"]["reward_scale"], **ep, **up, **terms)
-                self._log(row)
-                bar.update(data.numel())
-                bar.set_postfix(ret=f"{row.get('episode_return', float('nan')):.2f}", succ=f"{row.get('success_rate', float('nan')):.2f}")
-                if self.iteration % lc["checkpoint_every"] == 0:
-                    self.save()
-                if evaluating and lc["eval_every"] and self.iteration % lc["eval_every"] == 0:
-                    self._log_eval(self.evaluate())
-                done_iters += 1
-                t_last = time.perf_counter()
-                if max_iterations is not None and done_iters >= max_iterations:
-                    break
+            with self.stop_on_signals():
+                self._iterate(total, max_iterations, bar, evaluating)
+            self.save()  # not after an error: the last checkpoint stays as it was
         finally:
-            self.save()
             bar.close()
+        if self.stop_signal is not None:
+            return summary
         if evaluating and self.frames >= total:
             summary["end"] = self.evaluate()
             self._log_eval(summary["end"])
@@ -267,6 +265,42 @@ class PPOTrainer(Runner):
                 and not (self.run_dir / "final_eval.json").exists():
             summary["final"] = self.final_evaluation()
         return summary
+
+    def _iterate(self, total: int, max_iterations: Optional[int], bar, evaluating: bool) -> None:
+        """Iterations (collect, update, log, periodic checkpoint and evaluation) until ``total``
+        frames, ``max_iterations`` more, or a stop signal."""
+        lc = self.cfg["logging"]
+        t_last = time.perf_counter()
+        done_iters = 0
+        while self.frames < total:
+            data = self.collector.collect()
+            t_collect = time.perf_counter() - t_last
+            self.iteration += 1
+            self.frames += data.numel()
+            ep = self._episode_stats(data)
+            reward_raw = float(data["next", "reward"].mean())
+            ep["nonfinite"] = int(data["next", "info", "nonfinite"].sum())
+            t0 = time.perf_counter()
+            up = self.algo.update(data)
+            t_update = time.perf_counter() - t0
+            terms = {k: float(data["next", "info", k].mean()) for k in data["next", "info"].keys()
+                     if k.startswith("reward_")}
+            row = dict(iteration=self.iteration, frames=self.frames, wall_s=self._wall(),
+                       fps=data.numel() / max(t_collect + t_update, 1e-9), collect_s=t_collect, update_s=t_update,
+                       reward_raw=reward_raw, reward_scaled=reward_raw * self.cfg["gae"]["reward_scale"],
+                       **ep, **up, **terms)
+            self._log(row)
+            bar.update(data.numel())
+            bar.set_postfix(ret=f"{row.get('episode_return', float('nan')):.2f}",
+                            succ=f"{row.get('success_rate', float('nan')):.2f}")
+            if self.iteration % lc["checkpoint_every"] == 0:
+                self.save()
+            if evaluating and lc["eval_every"] and self.iteration % lc["eval_every"] == 0:
+                self._log_eval(self.evaluate())
+            done_iters += 1
+            t_last = time.perf_counter()
+            if (max_iterations is not None and done_iters >= max_iterations) or self.stop_signal is not None:
+                break
 
     def final_evaluation(self) -> dict:
         """The held-out evaluation of the finished expert: the paper's protocol for its skill on
@@ -307,7 +341,10 @@ class PPOTrainer(Runner):
         self.log_scalars(row, self.frames)
 
     def close(self):
+        collector = getattr(self, "collector", None)
         try:
-            self.collector.close()
+            if collector is not None:
+                collector.close()
         except Exception:
             pass
+        self.release()

@@ -1,7 +1,12 @@
 """What the PPO experts and the DAgger student share around their algorithms (rsl_rl's runner
-side): a run directory with an atomically written checkpoint and resume, the commits of every
-segment of a run, the RNG states, the wall clock over all segments, and the logs
-(``metrics.jsonl``, CSV files, TensorBoard).
+side): a run directory with an atomically written checkpoint and resume, the commits and
+overrides of every segment of a run, the RNG states, the wall clock over all segments, the logs
+(``metrics.jsonl``, CSV files, TensorBoard), a lock (one process per run directory) and signals.
+
+Faults: SIGINT and SIGTERM stop the run at the end of the current iteration, which is saved (a
+second SIGINT stops at once, keeping the last checkpoint); an error keeps the last checkpoint as
+it was (a segment that failed is not written over it); resuming cuts the logs back to the
+checkpoint's iteration, so rows written after it (by a run killed with -9) are not there twice.
 
 :class:`Runner` holds these; :class:`unicross.rl.ppo.PPOTrainer` and
 :class:`unicross.rl.dagger.DAggerTrainer` add their collection, update and evaluation loops.
@@ -9,18 +14,21 @@ segment of a run, the RNG states, the wall clock over all segments, and the logs
 from __future__ import annotations
 
 import csv
+import fcntl
 import json
 import os
 import random
+import signal
 import subprocess
 import time
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Optional
 
 import numpy as np
 import torch
 
-from unicross.config import deep_merge, load_config
+from unicross.config import deep_merge, load_config, validate_ranges
 
 CKPT_NAME = "checkpoint.pt"
 
@@ -33,12 +41,71 @@ def git_commit() -> str:
         return "unknown"
 
 
+def fsync_dir(path: Path) -> None:
+    """Makes a rename inside ``path`` durable."""
+    fd = os.open(path, os.O_RDONLY)
+    try:
+        os.fsync(fd)
+    finally:
+        os.close(fd)
+
+
 def atomic_save(obj, path: Path) -> None:
-    tmp = path.with_name(path.name + ".tmp")
+    """``torch.save`` to a temporary file of this process, fsync, rename over ``path``, fsync the
+    directory: a reader sees the old file or the new one, never a torn one."""
+    tmp = path.with_name(f"{path.name}.{os.getpid()}.tmp")
     torch.save(obj, tmp)
     with open(tmp, "rb") as f:
         os.fsync(f.fileno())
     os.replace(tmp, path)
+    fsync_dir(path.parent)
+
+
+def lock_run_dir(run_dir: Path):
+    """An exclusive lock on ``run_dir`` (the file ``.lock`` holds the owner's pid), released when the
+    process closes it or dies; a second process gets a clear error naming the holder."""
+    try:
+        run_dir.mkdir(parents=True, exist_ok=True)
+    except (FileExistsError, NotADirectoryError) as e:
+        raise ValueError(f"--out {run_dir}: cannot make the run directory ({e.strerror}: {e.filename})") from None
+    f = open(run_dir / ".lock", "a+")
+    try:
+        fcntl.flock(f.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except BlockingIOError:
+        f.seek(0)
+        holder = f.read().strip() or "?"
+        f.close()
+        raise RuntimeError(f"run directory {run_dir} is in use by another process (pid {holder}); "
+                           f"wait for it or stop it, or choose another --out") from None
+    f.seek(0)
+    f.truncate()
+    f.write(str(os.getpid()))
+    f.flush()
+    return f
+
+
+def truncate_logs(run_dir: Path, key: str, last: int) -> int:
+    """Drops the rows of ``metrics.jsonl`` and of the CSV logs in ``run_dir`` whose ``key``
+    (iteration, epoch) is past ``last``; returns how many rows were dropped."""
+    dropped = 0
+    for path in sorted(run_dir.glob("*.csv")) + [run_dir / "metrics.jsonl"]:
+        if not path.exists():
+            continue
+        lines = path.read_text().splitlines(keepends=True)
+        if path.suffix == ".jsonl":
+            keep = [l for l in lines if not l.strip() or json.loads(l).get(key, last) <= last]
+        else:
+            header = next(csv.reader(lines[:1]), [])
+            if key not in header:
+                continue
+            col = header.index(key)
+            keep = lines[:1] + [l for l in lines[1:] if int(float(next(csv.reader([l]))[col])) <= last]
+        if len(keep) < len(lines):
+            dropped += len(lines) - len(keep)
+            tmp = path.with_name(f"{path.name}.{os.getpid()}.tmp")
+            tmp.write_text("".join(keep))
+            os.replace(tmp, path)
+    return dropped
 
 
 def open_run(run_dir: Path, resume: bool, overrides: Optional[dict], config_name: str):
@@ -48,13 +115,24 @@ def open_run(run_dir: Path, resume: bool, overrides: Optional[dict], config_name
     if resume:
         if not ckpt_path.exists():
             raise FileNotFoundError(f"cannot resume: no checkpoint at {ckpt_path}")
-        ckpt = torch.load(ckpt_path, map_location="cpu", weights_only=False)
+        from unicross.rl.policy_io import read_torch_file
+        ckpt = read_torch_file(ckpt_path, "checkpoint")
+        kind = "distill" if "epoch" in ckpt else "train"  # DAgger counts epochs, PPO iterations
+        if (config_name == "dagger") != (kind == "distill"):
+            raise ValueError(f"{run_dir} is a `unicross {kind}` run: continue it with "
+                             f"`unicross {kind} --resume --out {run_dir}`")
         from unicross.rl.policy_io import check_modes
         check_modes(ckpt, ckpt_path)
-        return ckpt, deep_merge(ckpt["config"], overrides)
-    if ckpt_path.exists():
-        raise FileExistsError(f"{ckpt_path} exists: pass --resume to continue it or choose another --out")
-    return None, load_config(config_name, overrides)
+        cfg = deep_merge(ckpt["config"], overrides)
+        validate_ranges(config_name, cfg)
+    else:
+        if ckpt_path.exists():
+            raise FileExistsError(f"{ckpt_path} exists: pass --resume to continue it or choose another --out")
+        ckpt, cfg = None, load_config(config_name, overrides)
+    env = cfg.get("env") or {}  # the task and reward overrides the envs will apply: checked before any worker starts
+    load_config("task", env.get("task_config") or None)
+    load_config("reward", env.get("reward_config") or None)
+    return ckpt, cfg
 
 
 class Runner:
@@ -64,13 +142,18 @@ class Runner:
     ``config["seed"]``), return ``{**self.runner_state(), ...}`` from :meth:`state`, and call
     :meth:`load_runner_state` when resuming (``self.ckpt`` is the checkpoint, or None)."""
 
+    STEP_KEY = "iteration"  # the log column of the runner's unit of progress (DAgger: "epoch")
+
     def __init__(self, run_dir, resume: bool, overrides: Optional[dict], config_name: str, progress: bool = True):
         self.run_dir = Path(run_dir)
         self.ckpt, self.cfg = open_run(self.run_dir, resume, overrides, config_name)
+        self._lock = lock_run_dir(self.run_dir)
         self.progress = progress
-        # the code this segment runs (read once: HEAD may move while a long run trains)
+        self.stop_signal: Optional[int] = None  # set by SIGINT/SIGTERM while train() runs
+        # the code this segment runs (read once: HEAD may move while a long run trains) and its overrides
         self.commit = git_commit()
         self.commits = list((self.ckpt or {}).get("commits", [])) + [self.commit]
+        self.segments = list((self.ckpt or {}).get("segments", [])) + [dict(commit=self.commit, overrides=overrides or {})]
         self.wall_s = 0.0  # wall clock over all segments of the run
         self._wall_mark = time.perf_counter()
         self._writer = None  # TensorBoard, open between open_logs() and close_logs()
@@ -88,9 +171,11 @@ class Runner:
 
     def runner_state(self) -> dict:
         return dict(config=self.cfg, wall_s=self._wall(), git_commit=self.commit, commits=self.commits,
-                    rng=dict(torch=torch.get_rng_state(), numpy=np.random.get_state(), python=random.getstate()))
+                    segments=self.segments, rng=dict(torch=torch.get_rng_state(), numpy=np.random.get_state(), python=random.getstate()))
 
     def load_runner_state(self, ck: dict) -> None:
+        """Restores the RNG states and the wall clock, and cuts the logs back to the checkpoint."""
+        truncate_logs(self.run_dir, self.STEP_KEY, int(ck[self.STEP_KEY]))
         self.wall_s, self._wall_mark = float(ck.get("wall_s", 0.0)), time.perf_counter()
         torch.set_rng_state(ck["rng"]["torch"])
         np.random.set_state(ck["rng"]["numpy"])
@@ -99,6 +184,34 @@ class Runner:
     def save(self) -> None:
         self.run_dir.mkdir(parents=True, exist_ok=True)
         atomic_save(self.state(), self.run_dir / CKPT_NAME)
+
+    def release(self) -> None:
+        """Gives the run directory's lock back (``close()`` of the trainers)."""
+        if self._lock is not None:
+            self._lock.close()
+            self._lock = None
+
+    @contextmanager
+    def stop_on_signals(self):
+        """While the loop runs, SIGINT and SIGTERM set ``stop_signal`` (the loop saves and stops at
+        the end of its iteration); a second SIGINT raises KeyboardInterrupt at once. Outside the
+        main thread (no signal handlers there) it does nothing."""
+        def request(signum, frame):
+            if self.stop_signal == signal.SIGINT and signum == signal.SIGINT:
+                raise KeyboardInterrupt
+            self.stop_signal = signum
+            print(f"\n[unicross] {signal.Signals(signum).name}: stopping after this {self.STEP_KEY} "
+                  f"(SIGINT again to stop now)", flush=True)
+        try:
+            old = {s: signal.signal(s, request) for s in (signal.SIGINT, signal.SIGTERM)}
+        except ValueError:  # not the main thread
+            yield
+            return
+        try:
+            yield
+        finally:
+            for s, h in old.items():
+                signal.signal(s, h)
 
     def _wall(self) -> float:
         now = time.perf_counter()
