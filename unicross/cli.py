@@ -101,7 +101,9 @@ def _cmd_grasps(args) -> int:
 def _cmd_rollout(args) -> int:
     import gymnasium as gym
     import torch
-    import unicross  # noqa: F401
+    import unicross
+    if args.task not in unicross.TASK_IDS:
+        raise ValueError(f"unknown task {args.task!r}; valid: {list(unicross.TASK_IDS)}")
     kwargs = dict(obs_mode="state", sim_backend="physx_cpu", render_backend="none", hand=args.hand,
                   object_limit=args.limit)
     if args.objects:
@@ -129,6 +131,26 @@ def _cmd_rollout(args) -> int:
     for k, v in totals.items():
         print(f"  {k:24s} {v / steps:+.4f} per step")
     return 0
+
+
+def positive(text: str) -> int:
+    """argparse type: a whole number >= 1."""
+    return _int_at_least(text, 1)
+
+
+def natural(text: str) -> int:
+    """argparse type: a whole number >= 0."""
+    return _int_at_least(text, 0)
+
+
+def _int_at_least(text: str, low: int) -> int:
+    try:
+        v = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
+    if v < low:
+        raise argparse.ArgumentTypeError(f"must be >= {low}, got {v}")
+    return v
 
 
 ABLATIONS = ("no_target_obs", "no_target_action", "no_track_reward", "no_distance", "no_contact")
@@ -185,16 +207,28 @@ def _cmd_train(args) -> int:
         overrides.setdefault("env", {}).setdefault("task_config", {}).setdefault("ablation", {})[flag] = True
     if not args.resume and args.skill is None:
         raise ValueError("--skill is required (grasp, relocate, rotate, translate)")
-    trainer = PPOTrainer(args.out, args.skill or "grasp", args.axis, args.hand, overrides=overrides or None,
+    trainer = PPOTrainer(args.out, args.skill, args.axis, args.hand, overrides=overrides or None,
                          resume=args.resume)
     try:
         summary = trainer.train(max_iterations=args.max_iterations)
     finally:
         trainer.close()
+    if trainer.stop_signal is not None:
+        return _stopped(trainer, f"iteration {trainer.iteration}, {trainer.frames} frames")
     for k, v in summary.items():
         print(f"{k}: " + ", ".join(f"{a}={b:.4g}" if isinstance(b, float) else f"{a}={b}" for a, b in v.items()))
     print(f"checkpoint: {trainer.run_dir / 'checkpoint.pt'} (iteration {trainer.iteration}, {trainer.frames} frames)")
     return 0
+
+
+def _stopped(trainer, where: str) -> int:
+    """One line for a run stopped by SIGINT/SIGTERM (saved at the end of its iteration); the exit
+    status a shell gives a process killed by that signal."""
+    import signal
+    name = signal.Signals(trainer.stop_signal).name
+    print(f"stopped by {name}: saved {trainer.run_dir / 'checkpoint.pt'} ({where}); continue with --resume",
+          file=sys.stderr)
+    return 128 + int(trainer.stop_signal)
 
 
 def _cmd_export(args) -> int:
@@ -209,8 +243,8 @@ def _cmd_export(args) -> int:
     sidecar = dict(commands=args.command or [], hardware=dict(machine=platform.machine(), cpus=os.cpu_count(),
                                                                processor=platform.processor() or None,
                                                                python=platform.python_version()))
-    import torch
-    ck = torch.load(ckpt, map_location="cpu", weights_only=False)
+    from unicross.rl.policy_io import read_torch_file
+    ck = read_torch_file(ckpt, "checkpoint")
     sidecar["train_wall_s"] = round(float(ck.get("wall_s", 0.0)), 1)
     for f in args.eval or []:
         e = json.loads(Path(f).read_text())
@@ -262,7 +296,19 @@ def _cmd_eval(args) -> int:
     result = dict(label=label, policy=desc, objects=args.objects, limit=args.limit, hand=args.hand,
                   trials_per_object=args.trials_per_object, seed=args.seed, disturb=args.disturb,
                   original=args.original, randomize=args.randomize, ablation=ablation or {}, summaries={}, trials={})
+    out = Path(args.out)
+    if args.resume and out.is_file():  # the protocols a stopped evaluation finished are kept
+        done = json.loads(out.read_text())
+        same = [k for k in result if k not in ("label", "summaries", "trials") and done.get(k) != result[k]]
+        if same:
+            raise ValueError(f"--resume: {out} was evaluated with other settings ({', '.join(same)}); "
+                             f"use another --out or the same settings")
+        result["trials"], result["summaries"] = done["trials"], done["summaries"]
+    _write_eval(out, result)  # before simulating: an --out that cannot be written fails now
     for p in protocols:
+        if p in result["trials"]:
+            print(f"eval {p}: kept from {out} ({len(result['trials'][p])} trials)")
+            continue
         trials = E.run_protocol_workers(p, args.policy, objs, hand=args.hand, workers=args.workers, seed=args.seed,
                                         trials_per_object=args.trials_per_object, disturb=args.disturb,
                                         randomize=args.randomize, grasp_dataset=args.grasps, original=args.original,
@@ -271,14 +317,32 @@ def _cmd_eval(args) -> int:
                                         ablation=ablation)
         result["trials"][p] = trials
         result["summaries"][p] = E.summarize(p, trials)
-    out = Path(args.out)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(json.dumps(result, indent=1))
-    table = E.markdown_table({label: result["summaries"]})
-    out.with_suffix(".md").write_text(table + "\n")
+        _write_eval(out, result)  # each finished protocol is on disk before the next starts
+    table = _write_eval(out, result)
     print(table)
     print(f"wrote {out} and {out.with_suffix('.md')}")
     return 0
+
+
+def _write_eval(out: Path, result: dict) -> str:
+    """Writes an evaluation's JSON and markdown table atomically; returns the table."""
+    import os
+    from unicross import evaluation as E
+    if out.is_dir():
+        raise ValueError(f"--out {out} is a directory; give a file name such as {out / 'eval.json'}")
+    try:
+        out.parent.mkdir(parents=True, exist_ok=True)
+    except (FileExistsError, NotADirectoryError):
+        raise ValueError(f"--out {out}: {out.parent} is not a directory") from None
+    table = E.markdown_table({result["label"]: result["summaries"]}) if result["summaries"] else ""
+    for path, text in ((out, json.dumps(result, indent=1)), (out.with_suffix(".md"), table + "\n")):
+        tmp = path.with_name(f"{path.name}.{os.getpid()}.tmp")
+        try:
+            tmp.write_text(text)
+        except OSError as e:
+            raise ValueError(f"cannot write --out {out}: {e.strerror}") from None
+        os.replace(tmp, path)
+    return table
 
 
 def _cmd_report(args) -> int:
@@ -341,6 +405,8 @@ def _cmd_distill(args) -> int:
         last = trainer.train()
     finally:
         trainer.close()
+    if trainer.stop_signal is not None:
+        return _stopped(trainer, f"epoch {trainer.epoch}, {trainer.frames} frames")
     print(", ".join(f"{k}={v:.4g}" if isinstance(v, float) else f"{k}={v}" for k, v in last.items()))
     print(f"student checkpoint: {trainer.run_dir / 'checkpoint.pt'} (epoch {trainer.epoch})")
     return 0
@@ -387,8 +453,8 @@ def main(argv=None) -> int:
     s = sub.add_parser("grasps", help="build a grasp-state dataset (grasp expert, or the scripted synthesiser)")
     s.add_argument("--expert", default=None, help="grasp expert checkpoint (default: the scripted synthesiser)")
     s.add_argument("--objects", default="train", help="object set (train, test-wrappable, unseen, mesh:<file>, ...)")
-    s.add_argument("--limit", type=int, default=None, help="first N objects of each (category, type) group")
-    s.add_argument("--per-object", type=int, default=5)
+    s.add_argument("--limit", type=positive, default=None, help="first N objects of each (category, type) group")
+    s.add_argument("--per-object", type=positive, default=5)
     s.add_argument("--hand", default="allegro")
     s.add_argument("--out", required=True)
     s.add_argument("--seed", type=int, default=0)
@@ -404,10 +470,10 @@ def main(argv=None) -> int:
     s.add_argument("--task", default="UniCross-Grasp-v1")
     s.add_argument("--axis", default=None, help="rotate axis / translate direction")
     s.add_argument("--objects", default=None)
-    s.add_argument("--limit", type=int, default=2)
+    s.add_argument("--limit", type=positive, default=2)
     s.add_argument("--grasps", default=None, help="grasp dataset (default: the shipped one)")
     s.add_argument("--hand", default="allegro")
-    s.add_argument("--steps", type=int, default=200)
+    s.add_argument("--steps", type=positive, default=200)
     s.add_argument("--seed", type=int, default=0)
     s.add_argument("--zero", action="store_true", help="zero actions instead of random ones")
     s.set_defaults(fn=_cmd_rollout)
@@ -416,8 +482,8 @@ def main(argv=None) -> int:
                    help="checkpoint path, or zero | random | scripted-grasp | scripted-relocate")
     s.add_argument("--protocol", default="all", help="grasp, relocate, rotate, translate (comma list) or all")
     s.add_argument("--objects", default="test", help="object set: train | test | unseen (| -wrappable/-elongated | mesh:<file>)")
-    s.add_argument("--limit", type=int, default=None, help="first N objects per (category, type) group")
-    s.add_argument("--trials-per-object", type=int, default=load_config("eval")["trials_per_object"],
+    s.add_argument("--limit", type=positive, default=None, help="first N objects per (category, type) group")
+    s.add_argument("--trials-per-object", type=positive, default=load_config("eval")["trials_per_object"],
                    help="starts per object and axis (default: configs/eval.yaml, the paper's 25)")
     s.add_argument("--disturb", action="store_true", help="constant random force U[0, 10 m g] on the object")
     s.add_argument("--original", action="store_true",
@@ -427,13 +493,15 @@ def main(argv=None) -> int:
     s.add_argument("--hand", default="allegro")
     s.add_argument("--seed", type=int, default=0)
     s.add_argument("--label", default=None, help="row label in tables (default: the policy name)")
-    s.add_argument("--videos", type=int, default=0, help="record and render the first K trials of each protocol")
+    s.add_argument("--videos", type=natural, default=0, help="record and render the first K trials of each protocol")
     s.add_argument("--ablation", action="append", metavar="FLAG",
                    help="evaluate zero/scripted policies under one of the paper's ablations (repeatable; a "
                         "checkpoint always runs with the switches it was trained with): " + ", ".join(ABLATIONS))
-    s.add_argument("--workers", type=int, default=1,
+    s.add_argument("--workers", type=positive, default=1,
                    help="processes to split the objects over (same trials for any number; one env per process)")
-    s.add_argument("--out", required=True)
+    s.add_argument("--out", required=True, help="JSON with every trial (+ .md table), written after each protocol")
+    s.add_argument("--resume", action="store_true",
+                   help="finish an evaluation in --out that stopped: keep its finished protocols, run the rest")
     s.set_defaults(fn=_cmd_eval)
     s = sub.add_parser("report", help="assemble eval JSON files into the paper's table layout; --paper: evaluate "
                                       "the shipped checkpoints and write the paper's tables (docs/results.md)")
@@ -443,9 +511,9 @@ def main(argv=None) -> int:
     s.add_argument("--paper", action="store_true",
                    help="evaluate every shipped checkpoint of --hand with the paper's protocols and write the tables")
     s.add_argument("--hand", default="allegro")
-    s.add_argument("--limit", type=int, default=10, help="--paper: first N objects per (category, shape) group (0: all, the paper's full sets)")
-    s.add_argument("--trials-per-object", type=int, default=3, help="--paper: trials per object and axis")
-    s.add_argument("--workers", type=int, default=1, help="--paper: processes per evaluation")
+    s.add_argument("--limit", type=natural, default=10, help="--paper: first N objects per (category, shape) group (0: all, the paper's full sets)")
+    s.add_argument("--trials-per-object", type=positive, default=3, help="--paper: trials per object and axis")
+    s.add_argument("--workers", type=positive, default=1, help="--paper: processes per evaluation")
     s.add_argument("--seed", type=int, default=0)
     s.set_defaults(fn=_cmd_report)
     s = sub.add_parser("render", help="render a trajectory file to .mp4/.gif/.png (CPU: pyrender+EGL; GPU: SAPIEN)")
@@ -453,16 +521,16 @@ def main(argv=None) -> int:
     s.add_argument("--out", required=True, help="video.mp4, anim.gif or still.png (last frame)")
     s.add_argument("--camera", default="front", help="front | side | top | follow")
     s.add_argument("--size", default="640x480")
-    s.add_argument("--fps", type=int, default=None)
-    s.add_argument("--every", type=int, default=1, help="render every k-th step")
+    s.add_argument("--fps", type=positive, default=None)
+    s.add_argument("--every", type=positive, default=1, help="render every k-th step")
     s.add_argument("--renderer", default="auto", help="auto | pyrender | sapien")
     s.set_defaults(fn=_cmd_render)
     s = sub.add_parser("distill", help="DAgger: distil the ten experts into one student; resumable")
     s.add_argument("--experts", default=None, help="directory with <mode>/checkpoint.pt for all ten modes")
     s.add_argument("--out", required=True, help="run directory (student checkpoint.pt, metrics.jsonl, replay/)")
-    s.add_argument("--num-envs", type=int, default=None)
+    s.add_argument("--num-envs", type=positive, default=None)
     s.add_argument("--backend", choices=["physx_cpu", "physx_cuda"], default=None)
-    s.add_argument("--epochs", type=int, default=None)
+    s.add_argument("--epochs", type=positive, default=None)
     s.add_argument("--set", action="append", metavar="SECTION.KEY=VALUE", help="override configs/dagger.yaml")
     s.add_argument("--resume", action="store_true")
     s.set_defaults(fn=_cmd_distill)
@@ -471,8 +539,8 @@ def main(argv=None) -> int:
     s.add_argument("--sequence", default=None,
                    help="e.g. grasp,relocate,rotate:x+ (default: the paper's protocol, random in-hand axis)")
     s.add_argument("--objects", default="test")
-    s.add_argument("--limit", type=int, default=1)
-    s.add_argument("--trials-per-object", type=int, default=1)
+    s.add_argument("--limit", type=positive, default=1)
+    s.add_argument("--trials-per-object", type=positive, default=1)
     s.add_argument("--hand", default="allegro")
     s.add_argument("--seed", type=int, default=0)
     s.add_argument("--video", default=None, help="record the first trial and render it to this .mp4")
@@ -488,8 +556,8 @@ def main(argv=None) -> int:
     s.add_argument("--skill", choices=list(SKILLS), default="grasp")
     s.add_argument("--axis", default=None, help=axes_help)
     s.add_argument("--objects", default=None, help="object set (default: the skill's training set)")
-    s.add_argument("--limit", type=int, default=2, help="first N objects per (category, type) group")
-    s.add_argument("--seeds", type=int, default=3, help="episodes per object and behaviour")
+    s.add_argument("--limit", type=positive, default=2, help="first N objects per (category, type) group")
+    s.add_argument("--seeds", type=positive, default=3, help="episodes per object and behaviour")
     s.add_argument("--only", default=None, help="comma list of behaviours (default: all)")
     s.add_argument("--hand", default="allegro")
     s.add_argument("--preset", action="append", metavar="NAME", help="configs/presets/NAME.yaml (e.g. paper_reward)")
@@ -502,23 +570,29 @@ def main(argv=None) -> int:
     s.add_argument("--skill", choices=list(SKILLS), default=None)
     s.add_argument("--axis", default=None, help=axes_help)
     s.add_argument("--direction", dest="axis", help=argparse.SUPPRESS)
-    s.add_argument("--hand", default="allegro")
+    s.add_argument("--hand", default=None, help="default allegro (a resumed run keeps its own)")
     s.add_argument("--out", required=True, help="run directory (checkpoint, metrics.csv, metrics.jsonl, tb/)")
-    s.add_argument("--num-envs", type=int, default=None)
-    s.add_argument("--total-frames", type=int, default=None)
+    s.add_argument("--num-envs", type=positive, default=None)
+    s.add_argument("--total-frames", type=positive, default=None)
     s.add_argument("--backend", choices=["physx_cpu", "physx_cuda"], default=None)
-    s.add_argument("--max-iterations", type=int, default=None, help="stop (and checkpoint) after this many iterations")
+    s.add_argument("--max-iterations", type=positive, default=None, help="stop (and checkpoint) after this many iterations")
     s.add_argument("--set", action="append", metavar="SECTION.KEY=VALUE", help="override configs/ppo.yaml")
     s.add_argument("--ablation", action="append", metavar="FLAG",
                    help="one of the paper's ablations (repeatable): " + ", ".join(ABLATIONS))
     s.add_argument("--resume", action="store_true", help="continue the run in --out from its checkpoint")
     s.set_defaults(fn=_cmd_train)
-    args = p.parse_args(argv)
+    try:
+        args = p.parse_args(argv)
+    except SystemExit as e:  # --help (0) or a usage error (2, said by argparse): a status, as every command returns
+        return int(e.code or 0)
     try:
         return args.fn(args)
     except (ValueError, FileNotFoundError, FileExistsError, KeyError, RuntimeError) as e:  # incl. RenderUnavailable
         print(f"unicross {args.cmd}: error: {e}", file=sys.stderr)
         return 2
+    except KeyboardInterrupt:  # a second Ctrl-C (the first stops training at the end of its iteration)
+        print(f"unicross {args.cmd}: interrupted; the last checkpoint written stays as it was", file=sys.stderr)
+        return 130
 
 
 if __name__ == "__main__":

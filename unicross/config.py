@@ -2,6 +2,8 @@
 from __future__ import annotations
 
 import copy
+import math
+from numbers import Number
 from pathlib import Path
 from typing import Any, Mapping, Optional
 
@@ -31,8 +33,91 @@ def deep_merge(base: dict, override: Optional[Mapping[str, Any]], path: str = ""
         elif isinstance(out[k], dict) and isinstance(v, Mapping):
             out[k] = deep_merge(out[k], v, path + k + ".", strict=strict)
         else:
-            out[k] = copy.deepcopy(v)
+            out[k] = _checked(path + k, out[k], copy.deepcopy(v))
     return out
+
+
+def _kind(v) -> str:
+    if isinstance(v, bool):
+        return "true/false"
+    if isinstance(v, Number):
+        return "a number"
+    if isinstance(v, str):
+        return "a string"
+    if isinstance(v, (list, tuple)):
+        return "a list"
+    if isinstance(v, Mapping):
+        return "a section"
+    return type(v).__name__
+
+
+def _checked(key: str, default, value):
+    """``value`` if it has its default's kind (a number for a number, ...; ``1e6`` for a whole number
+    becomes 1000000), else a clear error. Null defaults and null overrides are free (null means
+    "derive it" where a default is null)."""
+    if default is None or value is None:
+        return value
+    if isinstance(default, int) and not isinstance(default, bool) and isinstance(value, float):
+        if not value.is_integer():
+            raise ValueError(f"config key {key!r} expects a whole number, got {value!r}")
+        return int(value)
+    want, got = _kind(default), _kind(value)
+    if want != got:
+        raise ValueError(f"config key {key!r} expects {want} (default {default!r}), got {value!r}")
+    return value
+
+
+# Ranges of the numbers whose wrong values run to garbage rather than fail: "section.key" ->
+# (low, low_inclusive); every number must be finite. Pairs ([lo, hi]) are checked elementwise and
+# must be ordered.
+RANGES = {
+    "task": {"sim.sim_freq": (0, False), "sim.control_freq": (0, False), "sim.contact_offset": (0, False),
+             "randomization.mass": (0, False), "randomization.friction": (0, True),
+             "randomization.joint_obs_noise": (0, True), "randomization.perturb_scale": (0, True),
+             "randomization.perturb_prob": (0, True), "disturbance.max_scale": (0, True),
+             "drop_threshold": (0, False), "episode_length.*": (1, True)},
+    "ppo": {"collector.total_frames": (1, True), "collector.frames_per_batch": (1, True),
+            "collector.horizon": (1, True), "env.num_envs": (1, True), "env.object_limit": (1, True),
+            "env.reconfiguration_freq": (0, True), "gae.gamma": (0, True), "gae.lmbda": (0, True),
+            "gae.reward_scale": (0, False), "optim.lr": (0, False), "optim.lr_min": (0, False),
+            "optim.lr_max": (0, False), "optim.mini_epochs": (1, True), "optim.minibatch_size": (1, True),
+            "logging.checkpoint_every": (1, True)},
+    "dagger": {"optim.epochs": (1, True), "optim.lr": (0, False), "optim.batch_size": (1, True),
+               "optim.grad_steps": (1, True), "buffer.capacity": (1, True), "collector.rollout_steps": (1, True),
+               "env.num_envs": (1, True), "env.object_limit": (1, True), "logging.checkpoint_every": (1, True)},
+}
+
+
+def _lookup(cfg: dict, path: str):
+    node = cfg
+    for k in path.split("."):
+        if not isinstance(node, Mapping) or k not in node:
+            return []
+        node = node[k]
+    return [(path, node)]
+
+
+def validate_ranges(name: str, cfg: dict) -> None:
+    """Refuses values of ``configs/<name>.yaml`` that are physically or numerically impossible
+    (negative mass, ``sim_freq`` 0, NaN, ...) with a message naming the valid range."""
+    for path, (low, inclusive) in RANGES.get(name, {}).items():
+        if path.endswith(".*"):
+            section = _lookup(cfg, path[:-2])
+            found = [(f"{path[:-2]}.{k}", v) for _, sec in section for k, v in sec.items()]
+        else:
+            found = _lookup(cfg, path)
+        for key, value in found:
+            values = value if isinstance(value, (list, tuple)) else [value]
+            for v in values:
+                if v is None:
+                    continue
+                bad = not isinstance(v, Number) or isinstance(v, bool) or not math.isfinite(v) \
+                    or (v < low if inclusive else v <= low)
+                if bad:
+                    rng = f">= {low}" if inclusive else f"> {low}"
+                    raise ValueError(f"config key {key!r} must be {rng} and finite, got {value!r}")
+            if isinstance(value, (list, tuple)) and len(value) == 2 and value[0] > value[1]:
+                raise ValueError(f"config key {key!r} is a range [low, high], got {value!r}")
 
 
 def load_config(name: str, overrides: Optional[Mapping[str, Any]] = None) -> dict:
@@ -40,7 +125,9 @@ def load_config(name: str, overrides: Optional[Mapping[str, Any]] = None) -> dic
     path = CONFIG_DIR / f"{name}.yaml"
     with open(path) as f:
         data = yaml.safe_load(f)
-    return deep_merge(data, overrides)
+    cfg = deep_merge(data, overrides)
+    validate_ranges(name, cfg)
+    return cfg
 
 
 def preset_names() -> list:

@@ -88,7 +88,8 @@ class GraspSet:
         if not path.exists():
             raise FileNotFoundError(f"grasp dataset not found: {path}; build one with "
                                     f"`unicross grasps --objects <set> --out {path}`")
-        raw = torch.load(path, map_location="cpu", weights_only=False)
+        from unicross.rl.policy_io import read_torch_file
+        raw = read_torch_file(path, "grasp dataset")
         if not isinstance(raw, dict) or raw.get("format") != FORMAT:
             raise ValueError(f"{path} is not a {FORMAT} grasp dataset")
         data = TensorDict(raw["data"], batch_size=[len(raw["data"]["object_id"])])

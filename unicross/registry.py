@@ -59,6 +59,8 @@ class Skill:
         if axis not in self.axes:
             word = self.axis_kwarg or "axis"
             plural = "axes" if word == "axis" else word + "s"
+            if axis is None:
+                raise ValueError(f"{self.name} needs --{word} (valid {plural}: {list(self.axes)})")
             raise ValueError(f"invalid {self.name} {word} {axis!r}; valid {plural}: {list(self.axes)}")
         return f"{self.name}_{axis}"
 

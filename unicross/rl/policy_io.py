@@ -27,12 +27,28 @@ def resolve_checkpoint(spec) -> Path:
     raise FileNotFoundError(f"checkpoint not found: {spec} (shipped checkpoints: {have})")
 
 
+def read_torch_file(path, what: str, device="cpu"):
+    """``torch.load`` of a file the user named, with a clear error for a directory or a file that is
+    not a torch file (``what``: "checkpoint", "grasp dataset")."""
+    path = Path(path)
+    if path.is_dir():
+        hint = f"; the run's checkpoint is {path / 'checkpoint.pt'}" if (path / "checkpoint.pt").exists() else ""
+        raise ValueError(f"{path} is a directory, not a {what}{hint}")
+    if not path.exists():
+        raise FileNotFoundError(f"{what} not found: {path}")
+    try:
+        return torch.load(path, map_location=device, weights_only=False)
+    except Exception as e:  # pickle/zip errors of all kinds
+        raise ValueError(f"{path} is not a UniCross {what} (it cannot be read by torch.load: "
+                         f"{type(e).__name__})") from None
+
+
 def export_policy(run_checkpoint, out, sidecar: dict) -> Path:
     """Writes the acting part of a PPO run checkpoint (policy weights with their observation
     statistics, sizes, config; no critic or optimiser) to ``out`` and ``sidecar`` (plus the
     checkpoint's own facts) to ``out`` with suffix ``.json``."""
     import json
-    ck = torch.load(run_checkpoint, map_location="cpu", weights_only=False)
+    ck = read_torch_file(run_checkpoint, "checkpoint")
     small = {k: ck[k] for k in SHIPPED_KEYS if k in ck}
     out = Path(out)
     out.parent.mkdir(parents=True, exist_ok=True)
@@ -47,9 +63,7 @@ def load_policy(path, device="cpu"):
     """(policy, checkpoint) from a PPO checkpoint (or a shipped ``<hand>/<mode>``); fails with a
     clear message if missing/invalid."""
     path = resolve_checkpoint(path)
-    if not path.exists():
-        raise FileNotFoundError(f"checkpoint not found: {path}")
-    ck = torch.load(path, map_location=device, weights_only=False)
+    ck = read_torch_file(path, "checkpoint", device)
     if not isinstance(ck, dict) or "policy" not in ck or "obs_dims" not in ck:
         raise ValueError(f"{path} is not a UniCross policy checkpoint")
     check_modes(ck, path)
