@@ -105,6 +105,11 @@ class UniCrossEnv(TaskScene, EpisodeStarts, StepMath, TaskStateIO, BaseEnv):
                  config: Optional[dict] = None, reward_config: Optional[dict] = None,
                  randomize: Optional[bool] = None, robot_uids=None, **kwargs):
         # ---- validate everything before any simulation starts
+        backend = str(kwargs.get("sim_backend", "auto")).split(":")[0]
+        gpu = backend in ("gpu", "cuda", "physx_cuda") or (backend == "auto" and int(kwargs.get("num_envs", 1)) > 1)
+        if gpu and (kwargs.get("reconfiguration_freq") or 0) > 0:
+            raise ValueError("reconfiguration_freq must be 0 on the GPU backend (ManiSkill cannot rebuild the "
+                             "scene at a partial reset; the objects spread over the sub-scenes instead)")
         if kwargs.get("control_mode") not in (None, "pd_joint_pos"):
             raise ValueError(f"UniCross tasks have one control mode, 'pd_joint_pos' (normalised residual joint "
                              f"targets, see formulation.map_action), not {kwargs['control_mode']!r}: pass "

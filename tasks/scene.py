@@ -11,7 +11,7 @@ import numpy as np
 import sapien
 import torch
 from mani_skill.utils.structs.actor import Actor
-from mani_skill.utils.structs.types import SimConfig
+from mani_skill.utils.structs.types import GPUMemoryConfig, SimConfig
 
 from unicross import formulation as F
 from unicross import registry as R
@@ -33,10 +33,22 @@ class TaskScene:
     @property
     def _default_sim_config(self):
         s = self.cfg["sim"]
-        return SimConfig(sim_freq=s["sim_freq"], control_freq=s["control_freq"],
+        n = self.num_envs  # GPU contact buffers grow with the batch (ManiSkill's in-hand tasks size them so)
+        gpu_memory = GPUMemoryConfig(max_rigid_contact_count=n * max(1024, n) * 8,
+                                     max_rigid_patch_count=n * max(1024, n) * 2, found_lost_pairs_capacity=2 ** 26)
+        return SimConfig(sim_freq=s["sim_freq"], control_freq=s["control_freq"], gpu_memory_config=gpu_memory,
                          scene_config=dict(contact_offset=s["contact_offset"],
                                            solver_position_iterations=s["solver_position_iterations"],
                                            solver_velocity_iterations=s["solver_velocity_iterations"]))
+
+    @property
+    def _default_human_render_camera_configs(self):
+        """``render_camera``, the camera ``unicross render --renderer sapien`` moves each frame (ManiSkill
+        creates it only when the scene can render)."""
+        from mani_skill.sensors.camera import CameraConfig
+        from mani_skill.utils import sapien_utils
+        pose = sapien_utils.look_at(eye=[0.45, 0.45, 0.55], target=[0.0, 0.0, 0.2])
+        return CameraConfig("render_camera", pose=pose, width=512, height=512, fov=1.0, near=0.01, far=10.0)
 
     @property
     def control_dt(self) -> float:
@@ -74,12 +86,14 @@ class TaskScene:
             b = self.scene.create_actor_builder()
             spec.add_to_builder(b, density=float(masses[i]) / spec.volume(), material=mat, can_render=can_render)
             b.set_scene_idxs([i])
-            b.initial_pose = sapien.Pose(p=[0.3 * i, 0, 0.5])
+            b.initial_pose = sapien.Pose(p=[0, 0, 0.5])  # one pose for all: each env is its own (sub-)scene
             actors.append(b.build(name=f"object-{i}"))
+            self.remove_from_state_dict_registry(actors[-1])
             for link in self.agent.robot.links:  # friction applies to hand and object alike
                 for shape in link._objs[i].collision_shapes:
                     shape.physical_material = mat
         self.obj = Actor.merge(actors, name="object")
+        self.add_to_state_dict_registry(self.obj)  # one [N, 13] entry "object" (as pick_single_ycb.py)
         dev = self.device
         self.obj_index = torch.tensor([p[0] for p in pairs], device=dev)
         self.mode = torch.tensor([p[1] for p in pairs], device=dev)

@@ -65,7 +65,8 @@ class EpisodeStarts:
         Returns hand and object poses, finger positions and targets, and the recorded coupled-joint
         positions (``(is_grasp, mimic_qpos)`` or None)."""
         dev, g, b = self.device, self._gen, len(env_idx)
-        gs = self.grasps.sample(self.obj_index[env_idx], self.object_names, g)
+        gs = self.grasps.sample(self.obj_index[env_idx], self.object_names, g,
+                                needed=~self._starts_on_table[self.mode[env_idx]])
         random_q = _random_quaternion(b, g, dev)
         if self.cfg["in_hand_orientation"] == "palm_up":  # palm normal (+x_h) up, random yaw
             psi = torch.rand(b, generator=g, device=dev) * 2 * math.pi

@@ -186,6 +186,9 @@ def test_user_errors_are_one_line_before_any_simulation(tmp_path, capsys):
         (["rollout", "--task", "Nope-v1"], "unknown task"),
         (["train", "--skill", "rotate", "--out", str(tmp_path / "r")], "rotate needs --axis"),
         (["train", "--skill", "grasp", "--out", str(garbage / "x")], "cannot make the run directory"),
+        (["rollout", "--task", "UniCross-Grasp-v1", "--axis", "y-"], "takes no --axis"),
+        (["render", str(garbage), "--out", str(tmp_path / "v.mp4"), "--size", "big"], "WIDTHxHEIGHT"),
+        (["render", str(garbage), "--out", str(tmp_path / "v.mp4")], "not a UniCross trajectory file"),
     ]
     for argv, message in cases:
         assert cli(argv) == 2, argv
@@ -239,3 +242,31 @@ def test_recorded_env_states_replay_to_the_same_observations(tmp_path):
             u.set_state_dict(state(states, i))
             assert torch.allclose(u.get_obs(), o, atol=1e-5), i
     replay.close()
+
+
+def test_mixed_batches_and_the_state_registry_hold_on_cpu():
+    """Found by reading against ManiSkill's GPU path, checked where the CPU can: a grasp-mode env
+    whose object has no grasp state no longer crashes a mixed-mode env (its grasp was sampled
+    although unused); the merged object is one entry of the state registry (as pick_single_ycb.py);
+    a GPU run that rebuilds scenes is refused before any simulation."""
+    import gymnasium as gym
+    from unicross.objects import get_object_set
+    objs = [o for o in get_object_set("unseen") if o.name in ("wrappable-sphere-unseen-000", "wrappable-sphere-unseen-001")]
+    env = gym.make("UniCross-MultiSkill-v1", obs_mode="state", sim_backend="physx_cpu", render_backend="none",
+                   objects=objs, modes=["grasp", "relocate"])
+    u = env.unwrapped
+    for s in range(6):  # seeds 3-5 start the grasp mode on the sphere that has no grasp
+        env.reset(seed=s)
+    assert list(u.get_state_dict()["actors"]) == ["object"]  # was "object-0" (the per-env actor)
+    env.close()
+    with pytest.raises(ValueError, match="reconfiguration_freq must be 0"):
+        gym.make("UniCross-Grasp-v1", sim_backend="physx_cuda", reconfiguration_freq=4)
+
+
+def test_the_readme_eval_example_runs_as_written(tmp_path):
+    """README, Commands: `unicross eval --policy zero --protocol all --objects test` (here one object
+    per group and one trial): every protocol runs with the shipped grasp set."""
+    out = tmp_path / "all.json"
+    assert cli(["eval", "--policy", "zero", "--protocol", "all", "--objects", "test", "--limit", "1",
+                "--trials-per-object", "1", "--out", str(out)]) == 0
+    assert set(json.loads(out.read_text())["trials"]) == {"grasp", "relocate", "rotate", "translate"}

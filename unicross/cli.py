@@ -109,14 +109,21 @@ def _cmd_rollout(args) -> int:
     if args.objects:
         kwargs["objects"] = args.objects
     if args.axis:
-        kwargs["axis" if "Rotate" in args.task else "direction"] = args.axis
+        from unicross.registry import SKILLS
+        skill = next((s for s in SKILLS.values() if s.env_id == args.task and s.axis_kwarg), None)
+        if skill is None:
+            raise ValueError(f"{args.task} takes no --axis (only {[s.env_id for s in SKILLS.values() if s.axes]} do)")
+        kwargs.update(skill.env_kwargs(args.axis))
     if args.grasps:
         kwargs["grasp_dataset"] = args.grasps
     env = gym.make(args.task, **kwargs)
     u = env.unwrapped
     obs, info = env.reset(seed=args.seed)
     g = torch.Generator().manual_seed(args.seed)
+    from unicross import formulation as F
+    print(f"{args.task}: mode {F.MODES[int(u.mode[0])]}, object {u.env_objects[0].name}")
     totals, steps, t0 = {}, 0, time.time()
+    ended = dict(dropped=0, truncated=0)
     for _ in range(args.steps):
         a = torch.zeros(u.hand_spec.dof) if args.zero else torch.rand(u.hand_spec.dof, generator=g) * 2 - 1
         obs, r, term, trunc, info = env.step(a)
@@ -125,9 +132,11 @@ def _cmd_rollout(args) -> int:
             if k.startswith("reward_"):
                 totals[k] = totals.get(k, 0.0) + float(v.mean())
         if bool(term.any()) or bool(trunc.any()):
+            ended["dropped" if bool(term.any()) else "truncated"] += 1
             obs, info = env.reset()
     dt = time.time() - t0
-    print(f"{args.task}: obs {tuple(obs.shape)}, {steps} steps in {dt:.1f}s ({steps / dt:.0f} steps/s)")
+    print(f"{args.task}: obs {tuple(obs.shape)}, {steps} steps in {dt:.1f}s ({steps / dt:.0f} steps/s); "
+          f"episodes ended: {ended['dropped']} by a drop, {ended['truncated']} at their length")
     for k, v in totals.items():
         print(f"  {k:24s} {v / steps:+.4f} per step")
     return 0
@@ -389,7 +398,11 @@ def _cmd_report_paper(args) -> int:
 
 def _cmd_render(args) -> int:
     from unicross.render import render
-    w, h = (int(v) for v in args.size.lower().split("x"))
+    try:
+        w, h = (int(v) for v in args.size.lower().split("x"))
+        assert w > 0 and h > 0
+    except (ValueError, AssertionError):
+        raise ValueError(f"--size takes WIDTHxHEIGHT in pixels, e.g. 640x480; got {args.size!r}") from None
     out = render(args.trajectory, args.out, camera=args.camera, width=w, height=h, fps=args.fps,
                  renderer=args.renderer, every=args.every)
     print(f"wrote {out}")

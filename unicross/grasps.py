@@ -113,8 +113,10 @@ class GraspSet:
         return GraspSet(sets[0].hand, names, torch.cat(parts), sets[0].source)
 
     def sample(self, env_object: torch.Tensor, env_object_names: Sequence[str],
-               generator: Optional[torch.Generator] = None) -> TensorDict:
-        """One random grasp per env for its object. ``env_object`` indexes ``env_object_names``."""
+               generator: Optional[torch.Generator] = None, needed: Optional[torch.Tensor] = None) -> TensorDict:
+        """One random grasp per env for its object. ``env_object`` indexes ``env_object_names``.
+        ``needed`` [B] (default all): the envs that use their grasp; an env that does not (a grasp-mode
+        env of a mixed batch) may hold an object without grasps and gets an arbitrary row."""
         key = tuple(env_object_names)
         if key not in self._index_cache:
             # table [num_env_objects, max_grasps] of dataset rows, padded by repetition
@@ -132,10 +134,12 @@ class GraspSet:
         table, counts = self._index_cache[key]
         dev = env_object.device
         obj = env_object.cpu()
-        if (counts[obj] == 0).any():
-            bad = sorted({env_object_names[i] for i in obj[counts[obj] == 0].tolist()})
+        need = torch.ones(len(obj), dtype=torch.bool) if needed is None else needed.cpu()
+        if (need & (counts[obj] == 0)).any():
+            bad = sorted({env_object_names[i] for i in obj[need & (counts[obj] == 0)].tolist()})
             raise ValueError(f"no grasps for objects {bad}")
         u = torch.rand(len(obj), generator=generator, device=dev).cpu()
-        pick = (u * counts[obj]).long().clamp(max=counts[obj] - 1)
+        c = counts[obj].clamp(min=1)  # an object without grasps (not needed): row 0 of its padded table
+        pick = (u * c).long().clamp(max=c - 1)
         rows = table[obj, pick]
         return self.data[rows].to(dev)

@@ -96,11 +96,15 @@ class Trajectory:
         path = Path(path)
         if not path.exists():
             raise FileNotFoundError(f"trajectory not found: {path}")
+        if path.suffix in (".h5", ".hdf5"):
+            raise ValueError(f"{path} is an HDF5 file (ManiSkill's RecordEpisode writes those); unicross render reads "
+                             f"UniCross trajectory files ({FORMAT}, .npz) written by `unicross eval --videos K` or "
+                             f"`unicross chain --video`; render a RecordEpisode run with its save_video=True")
         try:
             z = np.load(path, allow_pickle=False)
             meta = json.loads(str(z["meta"]))
         except Exception as e:
-            raise ValueError(f"{path} is not a UniCross trajectory file: {e}") from e
+            raise ValueError(f"{path} is not a UniCross trajectory file ({FORMAT}, .npz): {type(e).__name__}") from None
         if meta.get("format") != FORMAT:
             raise ValueError(f"{path} is not a {FORMAT} file")
         return Trajectory(meta, *(z[k] for k in ("qpos", "wrist_pose", "object_pose", "mode", "contact", "force",

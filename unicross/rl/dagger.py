@@ -103,7 +103,8 @@ class DAggerTrainer(Runner):
         modes = cfg["env"]["modes"] or list(F.MODES)
         paths = expert_paths(experts_dir, modes)  # refuses to start without every expert
         ec = cfg["env"]
-        kw = dict(randomize=ec["randomize"], reconfiguration_freq=ec["reconfiguration_freq"], modes=modes,
+        kw = dict(randomize=ec["randomize"], modes=modes,
+                  reconfiguration_freq=ec["reconfiguration_freq"] if ec["backend"] == "physx_cpu" else 0,
                   config=ec["task_config"] or None)
         if ec.get("objects"):
             kw["objects"] = ec["objects"]

@@ -69,7 +69,7 @@ def csv_fields() -> list:
 def env_kwargs_for(skill: str, axis: Optional[str], hand: str, env_cfg: dict) -> dict:
     """The env constructor arguments of one expert (validates skill and axis before any simulation)."""
     kw = dict(R.skill(skill).env_kwargs(axis), hand=hand, randomize=env_cfg["randomize"],
-              reconfiguration_freq=env_cfg["reconfiguration_freq"])
+              reconfiguration_freq=env_cfg["reconfiguration_freq"] if env_cfg["backend"] == "physx_cpu" else 0)
     if env_cfg.get("task_config"):
         kw["config"] = env_cfg["task_config"]
     if env_cfg.get("reward_config"):
