@@ -32,6 +32,13 @@ def _torus(path):
     return path
 
 
+def test_coacd_is_bounded_in_time_and_says_so(tmp_path, capsys):
+    path = _torus(tmp_path / "torus_slow.obj")
+    with pytest.raises(ValueError, match="did not finish"):
+        coacd_parts(str(path), threshold=0.049, timeout=0.5)
+    assert "CoACD: decomposing" in capsys.readouterr().err
+
+
 def test_user_mesh_is_decomposed_cached_and_simulated(tmp_path):
     path = _torus(tmp_path / "torus.obj")
     parts = coacd_parts(str(path))

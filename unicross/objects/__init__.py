@@ -19,6 +19,7 @@ from __future__ import annotations
 import dataclasses
 import hashlib
 import math
+import os
 from pathlib import Path
 from typing import List, Optional, Tuple
 
@@ -214,8 +215,49 @@ def load_user_mesh(path: str):
     return m
 
 
-def coacd_parts(path: str, threshold: float = 0.05) -> List[Path]:
-    """Convex decomposition of a user mesh with CoACD, cached by file content."""
+def _coacd_worker(vertices, faces, threshold, queue) -> None:
+    import coacd
+    coacd.set_log_level("error")
+    queue.put([(np.asarray(v), np.asarray(f)) for v, f in coacd.run_coacd(coacd.Mesh(vertices, faces),
+                                                                         threshold=threshold)])
+
+
+def _run_coacd(path: str, m, threshold: float, timeout: float) -> list:
+    """CoACD in a child process, with progress on stderr and a time bound (a clear error, not a hang)."""
+    import multiprocessing as mp
+    import sys
+    import time
+    ctx = mp.get_context("spawn")
+    queue = ctx.Queue()
+    proc = ctx.Process(target=_coacd_worker, args=(np.asarray(m.vertices), np.asarray(m.faces), threshold, queue),
+                       daemon=True)
+    t0 = time.time()
+    print(f"[unicross] CoACD: decomposing {path} ({len(m.faces)} faces; once per file, cached under "
+          f"{_cache_file('coacd', 'x', '').parent}; bound {timeout:.0f} s, UNICROSS_COACD_TIMEOUT)", file=sys.stderr)
+    proc.start()
+    result, last = None, t0
+    while result is None:
+        try:
+            result = queue.get(timeout=1.0)
+        except Exception:  # queue.Empty: still running, or died
+            now = time.time()
+            if not proc.is_alive():
+                raise RuntimeError(f"CoACD failed on {path} (exit code {proc.exitcode})") from None
+            if now - t0 > timeout:
+                proc.terminate()
+                raise ValueError(f"CoACD did not finish {path} ({len(m.faces)} faces) in {timeout:.0f} s: simplify "
+                                 f"or close the mesh, or raise UNICROSS_COACD_TIMEOUT") from None
+            if now - last >= 30:
+                print(f"[unicross] CoACD: {now - t0:.0f} s on {path} ...", file=sys.stderr)
+                last = now
+    proc.join()
+    print(f"[unicross] CoACD: {len(result)} convex parts in {time.time() - t0:.1f} s", file=sys.stderr)
+    return result
+
+
+def coacd_parts(path: str, threshold: float = 0.05, timeout: Optional[float] = None) -> List[Path]:
+    """Convex decomposition of a user mesh with CoACD, cached by file content; runs in a child
+    process within ``timeout`` seconds (default ``UNICROSS_COACD_TIMEOUT``, 600)."""
     m = load_user_mesh(path)
     key = hashlib.sha1(Path(path).read_bytes()).hexdigest() + f"-{threshold}"
     marker = _cache_file("coacd", key, ".parts")
@@ -223,10 +265,10 @@ def coacd_parts(path: str, threshold: float = 0.05) -> List[Path]:
         parts = [Path(p) for p in marker.read_text().split("\n") if p]
         if all(p.exists() for p in parts):
             return parts
-    import coacd
     import trimesh
-    coacd.set_log_level("error")
-    result = coacd.run_coacd(coacd.Mesh(m.vertices, m.faces), threshold=threshold)
+    if timeout is None:
+        timeout = float(os.environ.get("UNICROSS_COACD_TIMEOUT", "600"))
+    result = _run_coacd(path, m, threshold, timeout)
     parts = []
     for i, (v, f) in enumerate(result):
         out = marker.with_name(f"{marker.stem}_{i}.obj")
