@@ -80,14 +80,16 @@ def test_resume_cuts_the_logs_back_to_the_checkpoint(tiny_run):
     assert [line.split(",")[0] for line in (tiny_run / "metrics.csv").read_text().splitlines()[1:]] == ["1", "2", "3"]
 
 
-def test_resume_refuses_contradictions_and_applies_what_may_change(tiny_run):
+def test_resume_refuses_contradictions_and_applies_what_may_change(tiny_run, capsys):
     with pytest.raises(ValueError, match="cannot resume .* --skill rotate"):
         PPOTrainer(tiny_run, "rotate", axis="x+", resume=True, progress=False)
     with pytest.raises(ValueError, match="--hand mano"):
         PPOTrainer(tiny_run, hand="mano", resume=True, progress=False)
-    r = PPOTrainer(tiny_run, resume=True, progress=False, overrides=dict(optim=dict(lr=1.0e-5)))
+    r = PPOTrainer(tiny_run, resume=True, progress=False, overrides=dict(optim=dict(lr=1.0e-5), env=dict(num_envs=2)))
     assert r.algo.lr == 1.0e-5 and all(g["lr"] == 1.0e-5 for g in r.algo.optim.param_groups)
     r.close()
+    said = capsys.readouterr().out
+    assert "optim.lr=1e-05" in said and "env.num_envs=2 (was 1)" in said
     assert cli(["train", "--out", str(tiny_run), "--resume", "--skill", "relocate"]) == 2
 
 

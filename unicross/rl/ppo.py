@@ -155,6 +155,12 @@ class PPOTrainer(Runner):
                 for g in self.algo.optim.param_groups:
                     g["lr"] = self.algo.lr
                 print(f"[unicross] resumed with optim.lr={self.algo.lr:g} (the KL schedule goes on from there)")
+            before = self.ckpt["config"]
+            for path in ("env.num_envs", "collector.frames_per_batch", "collector.horizon"):
+                sec, key = path.split(".")
+                if before[sec].get(key) != cfg[sec].get(key):
+                    print(f"[unicross] resumed with {path}={cfg[sec].get(key)} (was {before[sec].get(key)}): "
+                          f"{num_envs} envs x {self.horizon} steps = {num_envs * self.horizon} frames per iteration")
         self.collector.set_actor(self.algo.actor)  # after loading: the workers share these weights
         self._ep_return = torch.zeros(num_envs, 1, device=self.device)
 
