@@ -66,6 +66,16 @@ def test_a_failed_segment_leaves_the_checkpoint_as_it_was(tiny_run, monkeypatch)
     assert ck["config"]["env"]["task_config"].get("randomization") is None  # the failed override is not kept
 
 
+def test_a_non_finite_loss_stops_the_run_and_keeps_the_checkpoint(tiny_run, monkeypatch):
+    before = (tiny_run / "checkpoint.pt").read_bytes()
+    r = PPOTrainer(tiny_run, resume=True, progress=False)
+    monkeypatch.setattr(r.algo, "update", lambda data: dict(loss_objective=float("nan"), kl=0.0))
+    with pytest.raises(RuntimeError, match="non-finite loss_objective at iteration 3"):
+        r.train(max_iterations=1)
+    r.close()
+    assert (tiny_run / "checkpoint.pt").read_bytes() == before
+
+
 def test_resume_cuts_the_logs_back_to_the_checkpoint(tiny_run):
     # what a run killed with -9 leaves: rows logged after its last checkpoint
     with open(tiny_run / "metrics.jsonl", "a") as f:

@@ -13,6 +13,7 @@ continues the same run directory at the next iteration. Metrics go to ``metrics.
 from __future__ import annotations
 
 import json
+import math
 import os
 import time
 from typing import Optional
@@ -289,6 +290,10 @@ class PPOTrainer(Runner):
             t0 = time.perf_counter()
             up = self.algo.update(data)
             t_update = time.perf_counter() - t0
+            bad = sorted(k for k, v in up.items() if isinstance(v, float) and not math.isfinite(v))
+            if bad:  # an error: the last checkpoint stays as it was
+                raise RuntimeError(f"non-finite {', '.join(bad)} at iteration {self.iteration}; stopped, the last "
+                                   f"checkpoint is kept (lower optim.lr, or check env.task_config/reward_config)")
             terms = {k: float(data["next", "info", k].mean()) for k in data["next", "info"].keys()
                      if k.startswith("reward_")}
             row = dict(iteration=self.iteration, frames=self.frames, wall_s=self._wall(),
