@@ -7,7 +7,7 @@ from unicross.tasks.registration import register_task
 from functools import partialmethod
 
 from unicross.config import load_config
-from unicross.registry import SKILLS, Skill
+from unicross.registry import SKILLS, axis_env_id
 from unicross.tasks.base import UniCrossEnv
 
 EPISODE_STEPS = load_config("task")["episode_length"]  # the TimeLimit of each id; the task truncates by its config
@@ -60,13 +60,6 @@ class MultiSkillEnv(UniCrossEnv):
     DEFAULT_OBJECTS = "train"
 
 
-def axis_env_id(skill: Skill, axis: str) -> str:
-    """The id with ``axis`` fixed, for clients that cannot pass env kwargs (ManiSkill's PPO baseline):
-    ``UniCross-Rotate-v1`` + ``y-`` -> ``UniCross-RotateYNeg-v1`` (gymnasium ids allow no '+')."""
-    name, _, version = skill.env_id.rpartition("-")
-    return f"{name}{axis[0].upper()}{'Pos' if axis[1] == '+' else 'Neg'}-{version}"
-
-
 def _register_axis_ids() -> tuple:
     """One id per mode of every skill with axes (``axis_env_id``), each a subclass of the skill's
     class with the axis fixed."""
@@ -84,4 +77,4 @@ def _register_axis_ids() -> tuple:
     return tuple(ids)
 
 
-AXIS_TASK_IDS = _register_axis_ids()
+AXIS_TASK_IDS = _register_axis_ids()  # the same as unicross.AXIS_TASK_IDS

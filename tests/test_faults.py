@@ -282,3 +282,14 @@ def test_the_readme_eval_example_runs_as_written(tmp_path):
     assert cli(["eval", "--policy", "zero", "--protocol", "all", "--objects", "test", "--limit", "1",
                 "--trials-per-object", "1", "--out", str(out)]) == 0
     assert set(json.loads(out.read_text())["trials"]) == {"grasp", "relocate", "rotate", "translate"}
+
+
+def test_help_does_not_import_the_simulator():
+    """`import unicross` registers the ids lazily: the CLI's help needs no ManiSkill, SAPIEN or torch."""
+    code = ("import sys, unicross.cli\n"
+            "assert unicross.cli.main(['--help']) == 0\n"
+            "heavy = [m for m in ('mani_skill', 'sapien', 'torch') if m in sys.modules]\n"
+            "assert not heavy, heavy\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert out.returncode == 0, out.stderr[-1500:]
+    assert "unicross train" in out.stdout

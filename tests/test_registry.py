@@ -4,6 +4,7 @@ from mani_skill.utils.registration import REGISTERED_ENVS
 import torch
 
 import unicross  # noqa: F401  (registers the task ids)
+import unicross.tasks.skills  # noqa: F401  (the task classes, registered with ManiSkill too)
 from unicross import formulation as F
 from unicross import registry as R
 from unicross.config import load_config

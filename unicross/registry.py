@@ -118,6 +118,13 @@ def axis_vector(axis: Optional[str]) -> Tuple[float, float, float]:
     return tuple(v)
 
 
+def axis_env_id(skill: Skill, axis: str) -> str:
+    """The id with ``axis`` fixed, for clients that cannot pass env kwargs (ManiSkill's PPO baseline):
+    ``UniCross-Rotate-v1`` + ``y-`` -> ``UniCross-RotateYNeg-v1`` (gymnasium ids allow no '+')."""
+    name, _, version = skill.env_id.rpartition("-")
+    return f"{name}{axis[0].upper()}{'Pos' if axis[1] == '+' else 'Neg'}-{version}"
+
+
 def mode_axis(mode: str) -> Optional[str]:
     """The axis of a mode name (None for axis-free modes)."""
     _, _, axis = mode.partition("_")
