@@ -65,3 +65,12 @@ def test_broken_mesh_fails_before_simulation(tmp_path, content):
         make("UniCross-Grasp-v1", objects=f"mesh:{path}")
     with pytest.raises(ValueError, match="not found"):
         make("UniCross-Grasp-v1", objects=f"mesh:{tmp_path / 'missing.obj'}")
+
+
+def test_a_large_user_mesh_is_simplified_before_coacd(capsys):
+    from unicross.objects import simplified_for_coacd
+    dense = trimesh.creation.icosphere(subdivisions=6, radius=0.03)  # 81,920 faces
+    small = simplified_for_coacd(dense, "dense", max_faces=20000)
+    assert len(small.faces) == 20000 and small.is_watertight
+    assert "simplified from 81920 to 20000 faces" in capsys.readouterr().err
+    assert simplified_for_coacd(small, "small", max_faces=20000) is small

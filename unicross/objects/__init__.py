@@ -222,6 +222,19 @@ def _coacd_worker(vertices, faces, threshold, queue) -> None:
                                                                          threshold=threshold)])
 
 
+COACD_MAX_FACES = 20000  # larger meshes are simplified first (quadric decimation): CoACD's time grows with faces
+
+
+def simplified_for_coacd(m, path: str = "mesh", max_faces: int = COACD_MAX_FACES):
+    """``m`` with at most ``max_faces`` faces (quadric decimation, said on stderr), else ``m`` itself."""
+    import sys
+    if len(m.faces) <= max_faces:
+        return m
+    out = m.simplify_quadric_decimation(face_count=max_faces)
+    print(f"[unicross] CoACD: {path} simplified from {len(m.faces)} to {len(out.faces)} faces first", file=sys.stderr)
+    return out
+
+
 def _run_coacd(path: str, m, threshold: float, timeout: float) -> list:
     """CoACD in a child process, with progress on stderr and a time bound (a clear error, not a hang)."""
     import multiprocessing as mp
@@ -231,6 +244,7 @@ def _run_coacd(path: str, m, threshold: float, timeout: float) -> list:
     queue = ctx.Queue()
     proc = ctx.Process(target=_coacd_worker, args=(np.asarray(m.vertices), np.asarray(m.faces), threshold, queue),
                        daemon=True)
+    m = simplified_for_coacd(m, path)
     t0 = time.time()
     print(f"[unicross] CoACD: decomposing {path} ({len(m.faces)} faces; once per file, cached under "
           f"{_cache_file('coacd', 'x', '').parent}; bound {timeout:.0f} s, UNICROSS_COACD_TIMEOUT)", file=sys.stderr)
