@@ -99,3 +99,28 @@ def test_dagger_resume(tmp_path, experts):
     r.train(epochs=1)
     assert r.epoch == 3
     r.close()
+
+
+@pytest.mark.slow
+def test_dagger_on_ray_env_actors_fills_the_buffer_local_workers_fill(tmp_path, experts):
+    """DAgger with collector.ray_address (a loopback Ray cluster) labels the same states as with
+    local worker processes: one epoch gives the same replay buffer, bit for bit."""
+    ray = pytest.importorskip("ray")
+    cfg = dict(env=dict(num_envs=2, object_limit=1, reconfiguration_freq=0, randomize=False,
+                        task_config=dict(episode_length=SHORT)),
+               collector=dict(rollout_steps=4), optim=dict(batch_size=8, grad_steps=1, epochs=1),
+               buffer=dict(capacity=100), logging=dict(checkpoint_every=1))
+    local = DAggerTrainer(tmp_path / "local", experts, overrides=cfg, progress=False)
+    local.train()
+    local.close()
+    ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False)
+    try:
+        on_ray = DAggerTrainer(tmp_path / "ray", experts, overrides=dict(cfg, collector=dict(rollout_steps=4, ray_address="local")),
+                               progress=False)
+        on_ray.train()
+        on_ray.close()
+    finally:
+        ray.shutdown()
+    a, b = local.rb[:], on_ray.rb[:]
+    for k in ("hand", "object", "goal", "expert_action", "mode"):
+        assert torch.equal(a[k], b[k]), k

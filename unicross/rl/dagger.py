@@ -115,11 +115,24 @@ class DAggerTrainer(Runner):
         kw["hand"] = self.teachers.hand
         self.env_kwargs = kw
         from unicross.rl.ppo import resolve_num_envs
-        # the student acts (its mean action) in worker processes with shared weights (lean collector)
-        self.collector = LeanCollector("UniCross-MultiSkill-v1", kw, resolve_num_envs(ec["num_envs"], ec["backend"]),
-                                       cfg["collector"]["rollout_steps"], seed=cfg["seed"] + 1000 * int(
-                                           (self.ckpt or {}).get("epoch", 0)),
-                                       backend=ec["backend"], deterministic=True)
+        # the student acts (its mean action) in worker processes with shared weights (lean collector),
+        # or in Ray env actors (collector.ray_address)
+        ray_address = cfg["collector"].get("ray_address")
+        if ray_address and ec["backend"] != "physx_cpu":
+            raise ValueError("collector.ray_address runs CPU env actors: it needs env.backend physx_cpu")
+        seed = cfg["seed"] + 1000 * int((self.ckpt or {}).get("epoch", 0))
+        if ray_address:
+            from unicross.rl.ray_collector import connect
+            connect(ray_address)  # before num_envs: null means one env per CPU of the cluster
+        num_envs = resolve_num_envs(ec["num_envs"], ec["backend"], ray_address)
+        steps = cfg["collector"]["rollout_steps"]
+        if ray_address:
+            from unicross.rl.ray_collector import RayCollector
+            self.collector = RayCollector("UniCross-MultiSkill-v1", kw, num_envs, steps, seed=seed,
+                                          address=ray_address, deterministic=True)
+        else:
+            self.collector = LeanCollector("UniCross-MultiSkill-v1", kw, num_envs, steps, seed=seed,
+                                           backend=ec["backend"], deterministic=True)
         self.dims, self.n_act = self.collector.dims, self.collector.n_act
         self.student, _, self.norm = make_models(self.dims, self.n_act, Bounded(-1.0, 1.0, (self.n_act,)),
                                                  cfg["model"])
