@@ -60,11 +60,10 @@ class MultiSkillEnv(UniCrossEnv):
     DEFAULT_OBJECTS = "train"
 
 
-def _register_axis_ids() -> tuple:
-    """One id per mode of every skill with axes (``axis_env_id``), each a subclass of the skill's
-    class with the axis fixed."""
+def _register_axis_ids() -> None:
+    """One id per mode of every skill with axes (``axis_env_id``; listed as ``unicross.AXIS_TASK_IDS``),
+    each a subclass of the skill's class with the axis fixed."""
     from mani_skill.utils.registration import REGISTERED_ENVS
-    ids = []
     for s in SKILLS.values():
         base = REGISTERED_ENVS[s.env_id].cls
         for axis in s.axes:
@@ -73,8 +72,6 @@ def _register_axis_ids() -> tuple:
                 __init__=partialmethod(base.__init__, **{s.axis_kwarg: axis}),
                 __doc__=f"{base.__doc__.strip()} The {s.axis_kwarg} is fixed to {axis}."))
             register_task(uid, max_episode_steps=EPISODE_STEPS[s.name])(cls)
-            ids.append(uid)
-    return tuple(ids)
 
 
-AXIS_TASK_IDS = _register_axis_ids()  # the same as unicross.AXIS_TASK_IDS
+_register_axis_ids()

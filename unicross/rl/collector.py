@@ -21,6 +21,7 @@ last one of an episode, before the reset), ``reward``, ``done``, ``terminated`` 
 from __future__ import annotations
 
 import math
+import os
 import signal
 import traceback
 from typing import Optional
@@ -252,3 +253,35 @@ class LeanCollector:
             if p.is_alive():
                 p.terminate()
         self._procs, self._conns = [], []
+
+
+def resolve_num_envs(num_envs, backend: str, ray_address: Optional[str] = None) -> int:
+    """``env.num_envs``: null means one env per usable CPU core (CPU backend; with Ray, per CPU
+    of the cluster, which it connects to first)."""
+    if ray_address:
+        if backend != "physx_cpu":
+            raise ValueError("collector.ray_address runs CPU env actors: it needs env.backend physx_cpu")
+        from unicross.rl.ray_collector import connect
+        connect(ray_address)
+    if num_envs is None:
+        if backend != "physx_cpu":
+            raise ValueError("env.num_envs must be set for the GPU backend (e.g. 4096)")
+        if ray_address:
+            import ray
+            return max(1, int(ray.cluster_resources().get("CPU", 1)))
+        return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+    if int(num_envs) < 1:
+        raise ValueError(f"env.num_envs must be >= 1, got {num_envs}")
+    return int(num_envs)
+
+
+def make_collector(env_id: str, env_kwargs: dict, num_envs: int, horizon: int, seed: int, backend: str,
+                   ray_address: Optional[str] = None, deterministic: bool = False):
+    """The collector of a trainer: Ray env actors when ``ray_address`` is set (see
+    :func:`resolve_num_envs`, which connects), else :class:`LeanCollector`."""
+    if ray_address:
+        from unicross.rl.ray_collector import RayCollector
+        return RayCollector(env_id, env_kwargs, num_envs, horizon, seed=seed, address=ray_address,
+                            deterministic=deterministic)
+    return LeanCollector(env_id, env_kwargs, num_envs, horizon, seed=seed, backend=backend,
+                         deterministic=deterministic)

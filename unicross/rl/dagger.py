@@ -28,7 +28,7 @@ from tqdm import tqdm
 
 from unicross import formulation as F
 from unicross import registry as R
-from unicross.rl.collector import LeanCollector
+from unicross.rl.collector import make_collector, resolve_num_envs
 from unicross.rl.models import OBS_KEYS, make_models
 from unicross.rl.policy_io import load_policy
 from unicross.rl.runner import CKPT_NAME, Runner, atomic_save
@@ -114,25 +114,13 @@ class DAggerTrainer(Runner):
         self.teachers = Teachers(paths, self.device)
         kw["hand"] = self.teachers.hand
         self.env_kwargs = kw
-        from unicross.rl.ppo import resolve_num_envs
         # the student acts (its mean action) in worker processes with shared weights (lean collector),
         # or in Ray env actors (collector.ray_address)
         ray_address = cfg["collector"].get("ray_address")
-        if ray_address and ec["backend"] != "physx_cpu":
-            raise ValueError("collector.ray_address runs CPU env actors: it needs env.backend physx_cpu")
         seed = cfg["seed"] + 1000 * int((self.ckpt or {}).get("epoch", 0))
-        if ray_address:
-            from unicross.rl.ray_collector import connect
-            connect(ray_address)  # before num_envs: null means one env per CPU of the cluster
-        num_envs = resolve_num_envs(ec["num_envs"], ec["backend"], ray_address)
-        steps = cfg["collector"]["rollout_steps"]
-        if ray_address:
-            from unicross.rl.ray_collector import RayCollector
-            self.collector = RayCollector("UniCross-MultiSkill-v1", kw, num_envs, steps, seed=seed,
-                                          address=ray_address, deterministic=True)
-        else:
-            self.collector = LeanCollector("UniCross-MultiSkill-v1", kw, num_envs, steps, seed=seed,
-                                           backend=ec["backend"], deterministic=True)
+        self.collector = make_collector("UniCross-MultiSkill-v1", kw, resolve_num_envs(ec["num_envs"], ec["backend"], ray_address),
+                                        cfg["collector"]["rollout_steps"], seed, ec["backend"], ray_address,
+                                        deterministic=True)
         self.dims, self.n_act = self.collector.dims, self.collector.n_act
         self.student, _, self.norm = make_models(self.dims, self.n_act, Bounded(-1.0, 1.0, (self.n_act,)),
                                                  cfg["model"])

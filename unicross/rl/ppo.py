@@ -26,24 +26,9 @@ from unicross import formulation as F
 from unicross import registry as R
 from unicross.rewards import term_names
 from unicross.rl.algorithm import PPO
-from unicross.rl.collector import LeanCollector
+from unicross.rl.collector import make_collector, resolve_num_envs
 from unicross.rl.models import OBS_KEYS  # noqa: F401  (re-exported for benchmarks)
 from unicross.rl.runner import CKPT_NAME, Runner, atomic_save, git_commit, open_run  # noqa: F401  (re-exported)
-
-
-def resolve_num_envs(num_envs, backend: str, ray_address: Optional[str] = None) -> int:
-    """``env.num_envs``: null means one env per usable CPU core (CPU backend; with Ray, per CPU
-    of the cluster)."""
-    if num_envs is None:
-        if backend != "physx_cpu":
-            raise ValueError("env.num_envs must be set for the GPU backend (e.g. 4096)")
-        if ray_address:
-            import ray
-            return max(1, int(ray.cluster_resources().get("CPU", 1)))
-        return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
-    if int(num_envs) < 1:
-        raise ValueError(f"env.num_envs must be >= 1, got {num_envs}")
-    return int(num_envs)
 
 
 def resolve_horizon(collector_cfg: dict, skill: str, num_envs: int) -> int:
@@ -124,23 +109,13 @@ class PPOTrainer(Runner):
         self.skill, self.axis, self.hand = skill, axis, hand
         self.env_id = R.skill(skill).env_id
         self.env_kwargs = env_kwargs_for(skill, axis, hand, cfg["env"])
-        ec, ray_address = cfg["env"], cfg["collector"].get("ray_address")
-        if ray_address and ec["backend"] != "physx_cpu":
-            raise ValueError("collector.ray_address runs CPU env actors: it needs env.backend physx_cpu")
-        if ray_address:
-            from unicross.rl.ray_collector import connect
-            connect(ray_address)
-        num_envs = resolve_num_envs(ec["num_envs"], ec["backend"], ray_address)
+        ec = cfg["env"]
+        num_envs = resolve_num_envs(ec["num_envs"], ec["backend"], cfg["collector"].get("ray_address"))
         self.horizon = resolve_horizon(cfg["collector"], skill, num_envs)
         # envs of a resumed run start from new seeds (not a replay of the first iteration's starts)
         seed = cfg["seed"] + 1000 * int((self.ckpt or {}).get("iteration", 0))
-        if ray_address:
-            from unicross.rl.ray_collector import RayCollector
-            self.collector = RayCollector(self.env_id, self.env_kwargs, num_envs, self.horizon, seed=seed,
-                                          address=ray_address)
-        else:
-            self.collector = LeanCollector(self.env_id, self.env_kwargs, num_envs, self.horizon, seed=seed,
-                                           backend=ec["backend"])
+        self.collector = make_collector(self.env_id, self.env_kwargs, num_envs, self.horizon, seed, ec["backend"],
+                                        cfg["collector"].get("ray_address"))
         if ec["backend"] == "physx_cpu":  # workers and the update take turns: the update gets every core
             torch.set_num_threads(os.cpu_count() or 1)
         self.device = self.collector.device
