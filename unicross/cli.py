@@ -308,9 +308,9 @@ def _cmd_eval(args) -> int:
     out = Path(args.out)
     if args.resume and out.is_file():  # the protocols a stopped evaluation finished are kept
         done = json.loads(out.read_text())
-        same = [k for k in result if k not in ("label", "summaries", "trials") and done.get(k) != result[k]]
-        if same:
-            raise ValueError(f"--resume: {out} was evaluated with other settings ({', '.join(same)}); "
+        differ = [k for k in result if k not in ("label", "summaries", "trials") and done.get(k) != result[k]]
+        if differ:
+            raise ValueError(f"--resume: {out} was evaluated with other settings ({', '.join(differ)}); "
                              f"use another --out or the same settings")
         result["trials"], result["summaries"] = done["trials"], done["summaries"]
     _write_eval(out, result)  # before simulating: an --out that cannot be written fails now
