@@ -59,15 +59,6 @@ def _freeze_heap_once() -> None:
         _HEAP_FROZEN = True
 
 
-def _tensors(obs):
-    """The tensors of an observation (a tensor or nested dicts of tensors)."""
-    if torch.is_tensor(obs):
-        yield obs
-    elif isinstance(obs, dict):
-        for v in obs.values():
-            yield from _tensors(v)
-
-
 def _map_tensors(obs, fn):
     if torch.is_tensor(obs):
         return fn(obs)
@@ -115,8 +106,9 @@ class UniCrossEnv(TaskScene, EpisodeStarts, StepMath, TaskStateIO, BaseEnv):
                              f"targets, see formulation.map_action), not {kwargs['control_mode']!r}: pass "
                              f"control_mode='pd_joint_pos' (ManiSkill's PPO baseline: --control_mode pd_joint_pos)")
         self._compiled = compile_enabled()  # UNICROSS_COMPILE (unicross/compiling.py), read once per env
-        self._step_math = maybe_compile(self._step_math_eager) if self._compiled else self._step_math_eager
-        self._command_math = maybe_compile(self._command_math_eager) if self._compiled else self._command_math_eager
+        self._step_math = maybe_compile(self._step_math_eager, cpu=not gpu) if self._compiled else self._step_math_eager
+        self._command_math = (maybe_compile(self._command_math_eager, cpu=not gpu) if self._compiled
+                              else self._command_math_eager)
         self.hand_spec: HandSpec = load_hand(hand)
         if hand_overrides:
             import dataclasses
@@ -178,6 +170,8 @@ class UniCrossEnv(TaskScene, EpisodeStarts, StepMath, TaskStateIO, BaseEnv):
         n = self.hand_spec.dof
         self.single_action_space = spaces.Box(-1.0, 1.0, (n,), dtype=np.float32)
         self.action_space = batch_space(self.single_action_space, self.num_envs)
+        # the thin step (``step``): the state observation and a dense reward, as training uses
+        self._thin_step = self._obs_mode == "state" and self._reward_mode in ("dense", "normalized_dense")
         _freeze_heap_once()
 
 
@@ -265,6 +259,12 @@ class UniCrossEnv(TaskScene, EpisodeStarts, StepMath, TaskStateIO, BaseEnv):
 
     # ------------------------------------------------------------------ stepping
     def step(self, action):
+        """One control step. With the ``state`` observation and a dense reward (what training uses)
+        the step is thin: ManiSkill's substeps and hooks (``_step_action``) and ``get_info()`` run as
+        in ``BaseEnv.step``, and the compiled step math already holds the flat observation, the
+        reward sum, termination and the non-finite check (``StepMath._step_outputs``), so ManiSkill's
+        generic observation/reward assembly and flattening are skipped (equal results, tested).
+        Other observation and reward modes go through ``BaseEnv.step``."""
         a = common.to_tensor(action, device=self.device)
         if a.ndim == 1:
             a = a[None]
@@ -276,21 +276,20 @@ class UniCrossEnv(TaskScene, EpisodeStarts, StepMath, TaskStateIO, BaseEnv):
         self._apply_command(self._command_math(a, self.elapsed_steps))
         self._pending = torch.ones_like(self._pending)  # evaluate() advances targets once per step
         self._stepped = True
-        obs, reward, _, _, info = super().step(None)  # drive targets are set; ManiSkill runs the substeps
-        terminated = info["fail"].clone() if self.cfg["terminate_on_drop"] else torch.zeros_like(info["fail"])
-        truncated = self.elapsed_steps >= self.episode_length[self.mode]
-        # a non-finite observation or reward (a physics blow-up) never reaches a learner: it is
-        # zeroed, reported as info["nonfinite"], and the env's episode ends (truncated) to be reset
-        bad = ~torch.isfinite(reward) if torch.is_tensor(reward) else torch.zeros_like(truncated)
-        for x in _tensors(obs):
-            bad = bad | ~torch.isfinite(x.reshape(self.num_envs, -1)).all(-1)
-        info["nonfinite"] = bad
-        if bool(bad.any()):
-            reward = torch.where(bad, torch.zeros_like(reward), reward)
+        if self._thin_step:
+            self._step_action(None)  # drive targets are set; ManiSkill runs the substeps and hooks
+            self._elapsed_steps += 1
+            info = self.get_info()
+            obs, reward, terminated, truncated = self._step_out
+            self._last_obs = obs
+            return obs, reward, terminated, truncated, info
+        obs, reward, _, _, info = super().step(None)
+        _, _, terminated, truncated = self._step_out
+        if bool(info["nonfinite"].any()):  # zeroed (a physics blow-up never reaches a learner)
+            bad = info["nonfinite"]
+            reward = torch.where(bad, torch.zeros_like(reward), reward) if torch.is_tensor(reward) else reward
             obs = _map_tensors(obs, lambda x: torch.nan_to_num(x, nan=0.0, posinf=0.0, neginf=0.0))
-            truncated = truncated | bad
         return obs, reward, terminated, truncated, info
-
 
     def _before_control_step(self):
         """This control step's external object forces for all substeps at once: the decaying random
@@ -339,10 +338,9 @@ class UniCrossEnv(TaskScene, EpisodeStarts, StepMath, TaskStateIO, BaseEnv):
 
 
     def evaluate(self) -> dict:
-        pend = self._pending
-        info = self._step_math(*self._read(), self.elapsed_steps)
-        if self._obs_noise_on:  # random draws stay outside the compiled math
-            self.obs_noise = torch.where(pend[:, None], self._draw_obs_noise(self.num_envs), self.obs_noise)
+        # random draws stay outside the compiled math; the noise is drawn at every evaluation
+        noise = self._draw_obs_noise(self.num_envs) if self._obs_noise_on else self.obs_noise
+        info, self._step_out = self._step_math(*self._read(), self.elapsed_steps, noise)
         return info
 
 

@@ -71,7 +71,7 @@ class TaskStateIO:
         # the observation reflects the restored state; no random draw (evaluate() would draw the
         # observation noise), so the task generator's sequence stays the episode's and a replay by
         # env states steps on as the recording did
-        self._step_math(*self._read(), self.elapsed_steps)
+        self._step_math(*self._read(), self.elapsed_steps, self.obs_noise)
 
     def set_state(self, state, env_idx: torch.Tensor = None):
         """ManiSkill's flat-vector ``set_state`` with the task state: ManiSkill 3.0.1 rebuilds only the

@@ -14,6 +14,7 @@ import torch
 
 from unicross import formulation as F
 from unicross import registry as R
+from unicross.observations import observe_flat
 from unicross.geometry import (
     closest_point_shapes, pose_mul, quat_apply,
     quat_angle, quat_inv,
@@ -66,14 +67,21 @@ class StepMath:
                     link_distance=torch.linalg.norm(vec_h, dim=-1), force=force, qpos=q,
                     finger_torque=torque)
 
-    def _step_math_eager(self, pos, quat, force, qpos, qvel, elapsed_steps) -> dict:
+    def _step_math_eager(self, pos, quat, force, qpos, qvel, elapsed_steps, noise):
         """Everything ``evaluate()`` computes from the step's reads: distances, relational poses,
-        velocities, accumulated motion, drop, success, reward terms, the next targets and the
-        observation parts. Pure tensor math on the task's state (no reads, no random draws), so it
-        compiles to one graph (``UNICROSS_COMPILE``)."""
+        velocities, accumulated motion, drop, success, reward terms, the next targets, the
+        observation parts and the joint-reading noise (``noise``, drawn outside: a step's new
+        draw, kept only after a physics step). Pure tensor math on the task's state (no reads, no
+        random draws), so it compiles to one graph (``UNICROSS_COMPILE``).
+
+        Returns ``(info, out)``: ``info`` is ``evaluate()``'s; ``out`` = (state observation, dense
+        reward, terminated, truncated) as ``step()`` returns them when ManiSkill's generic assembly
+        is skipped (``UniCrossEnv.step``): a non-finite observation or reward (a physics blow-up)
+        is zeroed, reported as ``info["nonfinite"]`` and ends the episode (truncated)."""
         m = self._measure(pos, quat, force, qpos, qvel)
         cur = F.relational_poses(self.root_p, self.root_q, m["hand_p"], m["hand_q"], m["obj_p"], m["obj_q"])
         pend = self._pending
+        self.obs_noise = torch.where(pend[:, None], noise, self.obs_noise)
         skill = F.MODE_SKILL_ID.to(self.device)[self.mode]
         axis_prev = self.axis
         goal_err_prev, goal_err = self._goal_errors(cur)
@@ -99,7 +107,19 @@ class StepMath:
                     rotation=self.rot_acc.clone(), translation=self.trans_acc.clone(),
                     num_contacts=contact.sum(-1), mode=self.mode.clone())
         info.update({f"reward_{k}": v for k, v in terms.items()})
-        return info
+        return info, self._step_outputs(info, elapsed_steps)
+
+    def _step_outputs(self, info: dict, elapsed_steps):
+        """(state observation, dense reward, terminated, truncated) after the step, non-finite rows
+        zeroed and truncated; sets ``info["nonfinite"]``."""
+        reward = sum(info[f"reward_{k}"] for k in self.rewards.names)
+        obs = observe_flat(self, self._obs_terms)
+        bad = ~torch.isfinite(reward) | ~torch.isfinite(obs).all(-1)
+        info["nonfinite"] = bad
+        terminated = info["fail"].clone() if self.cfg["terminate_on_drop"] else torch.zeros_like(info["fail"])
+        truncated = (elapsed_steps >= self.episode_length[self.mode]) | bad
+        obs = torch.nan_to_num(obs, nan=0.0, posinf=0.0, neginf=0.0)
+        return obs, torch.where(bad, torch.zeros_like(reward), reward), terminated, truncated
 
     def _goal_errors(self, cur: F.Relational):
         """The object's position (m) and angle (rad) error to its final root-frame pose before and

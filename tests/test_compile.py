@@ -3,7 +3,7 @@ import pytest
 import torch
 
 from conftest import make
-from unicross.compiling import compile_enabled, maybe_compile
+from unicross.compiling import CPU_OPTIONS, compile_enabled, maybe_compile
 
 IDS = [("UniCross-Grasp-v1", {}), ("UniCross-Relocate-v1", {}), ("UniCross-Rotate-v1", {"axis": "x-"}),
        ("UniCross-Translate-v1", {"direction": "z+"}), ("UniCross-MultiSkill-v1", {})]
@@ -37,21 +37,24 @@ def _compare(task, kw, grasp_file):
     saved = dict(vars(u))
     eager_targets, eager_command = u._command_math_eager(a, u.elapsed_steps), u.command
     vars(u).update(saved)
-    targets = torch.compile(u._command_math_eager, fullgraph=True, dynamic=False)(a, u.elapsed_steps)
+    targets = torch.compile(u._command_math_eager, fullgraph=True, dynamic=False, options=CPU_OPTIONS)(a, u.elapsed_steps)
     torch.testing.assert_close(targets, eager_targets, atol=1e-5, rtol=1e-5)
     torch.testing.assert_close(u.command, eager_command, atol=1e-5, rtol=1e-5)
     vars(u).update(saved)
     # the math after the reads
     u._pending = torch.ones_like(u._pending)  # as right after a physics step
     reads = u._read()
+    noise = torch.rand(u.obs_noise.shape, generator=g) * 0.02
     saved = dict(vars(u))
-    eager_info = u._step_math_eager(*reads, u.elapsed_steps)
+    eager_info, eager_out = u._step_math_eager(*reads, u.elapsed_steps, noise)
     eager_state = dict(vars(u))
     vars(u).update(saved)
     u._closest_kinds = frozenset(range(4))  # as when compiling: every primitive's formula, selected per env
-    compiled = torch.compile(u._step_math_eager, fullgraph=True, dynamic=False)
-    info = compiled(*reads, u.elapsed_steps)
+    compiled = torch.compile(u._step_math_eager, fullgraph=True, dynamic=False, options=CPU_OPTIONS)
+    info, out = compiled(*reads, u.elapsed_steps, noise)
     assert info.keys() == eager_info.keys()
+    for name, got, want in zip(("obs", "reward", "terminated", "truncated"), out, eager_out):
+        torch.testing.assert_close(got, want, atol=1e-5, rtol=1e-5, msg=lambda m: f"{task} {name}: {m}")
     for k, v in eager_info.items():
         torch.testing.assert_close(info[k], v, atol=1e-5, rtol=1e-5, msg=lambda m: f"{task} info[{k}]: {m}")
     state = dict(vars(u))

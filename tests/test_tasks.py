@@ -40,6 +40,36 @@ def test_state_dict_obs_mode(grasp_file):
     env.close()
 
 
+@pytest.mark.parametrize("task,kw", [("UniCross-MultiSkill-v1", {}), ("UniCross-Grasp-v1", {})])
+def test_thin_step_equals_maniskills_generic_step(task, kw, grasp_file):
+    """The thin step (state observation, dense reward) returns what BaseEnv.step's generic assembly
+    returns from the same episode: observation (ManiSkill's flattening of the observation dict),
+    reward, terminated, truncated and info, bit for bit, with randomisation (noise, pushes) live;
+    and the state_dict observation mode carries the same numbers."""
+    def run(thin, obs_mode="state"):
+        env = make(task, grasp_file, randomize=True, obs_mode=obs_mode, **kw)
+        u = env.unwrapped
+        assert u._thin_step == (obs_mode == "state")
+        u._thin_step = thin
+        out = [u.reset(seed=5)]
+        g = torch.Generator().manual_seed(2)
+        for _ in range(12):
+            out.append(u.step((torch.rand(1, 22, generator=g) * 2 - 1) * 0.5))
+        env.close()
+        return out
+    thin, generic, as_dict = run(True), run(False), run(False, "state_dict")
+    from mani_skill.utils.common import flatten_state_dict
+    for i, (a, b, c) in enumerate(zip(thin, generic, as_dict)):
+        assert torch.equal(a[0], b[0]), f"observation differs at step {i}"
+        assert torch.equal(a[0], flatten_state_dict(c[0], use_torch=True)), f"state_dict differs at step {i}"
+        for x, y in zip(a[1:-1], b[1:-1]):
+            assert torch.equal(x, y)
+        info_a, info_b = a[-1], b[-1]
+        assert info_a.keys() == info_b.keys()
+        for k in info_a:
+            assert torch.equal(torch.as_tensor(info_a[k]), torch.as_tensor(info_b[k])), f"info[{k}] at step {i}"
+
+
 def test_nan_action_raises():
     env = make("UniCross-Grasp-v1")
     env.reset(seed=0)

@@ -56,6 +56,14 @@ def observe(env, terms: Dict[str, List[Callable]]) -> dict:
                 goal=torch.cat([fn(env) for _, fn in terms["goal"]], dim=-1))
 
 
+def observe_flat(env, terms: Dict[str, List[Callable]]) -> torch.Tensor:
+    """The ``state`` observation [N, D]: what ManiSkill's flattening of ``{"agent": {}, "extra":
+    observe(env, terms)}`` gives (hand terms, object terms, goal terms, in order), in one ``cat``
+    that runs inside the compiled step (``StepMath._step_math_eager``)."""
+    n = env.num_envs
+    return torch.cat([fn(env).reshape(n, -1) for group in GROUPS for _, fn in terms[group]], dim=-1)
+
+
 @observation_term("joint_pos")
 def joint_pos(env) -> torch.Tensor:
     """Actuated joint positions (virtual wrist + fingers) with the episode's reading noise."""

@@ -55,19 +55,26 @@ class HandObjectSensor:
             self.scene.px.gpu_query_contact_pair_impulses(self._query)
             imp = self._query.cuda_impulses.torch().view(self.num_links, self.scene.num_envs, 3)
             return imp.transpose(0, 1) / dt
-        out = np.zeros((self.num_links, 3), dtype=np.float32)
-        obj = self._obj_entity
-        lookup = self._link_of_entity
-        for c in self.scene.px.get_contacts():
-            e0, e1 = c.bodies[0].entity.per_scene_id, c.bodies[1].entity.per_scene_id
-            if e0 == obj and e1 in lookup:
-                sign, link = -1.0, lookup[e1]
-            elif e1 == obj and e0 in lookup:
-                sign, link = 1.0, lookup[e0]
+        obj, lookup = self._obj_entity, self._link_of_entity
+        links, signs, impulses = [], [], []
+        for c in self.scene.px.get_contacts():  # one pass; numpy work once for all points
+            b0, b1 = c.bodies
+            e0, e1 = b0.entity.per_scene_id, b1.entity.per_scene_id
+            if e0 == obj:
+                sign, link = -1.0, lookup.get(e1)
+            elif e1 == obj:
+                sign, link = 1.0, lookup.get(e0)
             else:
                 continue
-            for p in c.points:
-                out[link] += sign * p.impulse
+            if link is None:
+                continue
+            points = c.points
+            impulses.extend([p.impulse for p in points])
+            links.extend([link] * len(points))
+            signs.extend([sign] * len(points))
+        out = np.zeros((self.num_links, 3), dtype=np.float32)
+        if impulses:  # summed point by point in contact order, as a per-point loop would
+            np.add.at(out, links, np.asarray(impulses, dtype=np.float32) * np.asarray(signs, dtype=np.float32)[:, None])
         return torch.from_numpy(out / dt)[None]
 
     def apply_object_force(self, force) -> None:
