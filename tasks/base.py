@@ -35,7 +35,7 @@ from unicross.compiling import compile_enabled, maybe_compile
 from unicross.config import load_config
 from unicross.grasps import GraspSet, default_grasp_path
 from unicross.objects import resolve_objects
-from unicross.observations import observe, resolve as resolve_observation
+from unicross.observations import obs_layout, observe, resolve as resolve_observation, unflatten
 from unicross.robots.hand import HandSpec, load_hand, register_hand_agent
 from unicross.tasks.scene import TaskScene
 from unicross.tasks.starts import EpisodeStarts
@@ -170,8 +170,10 @@ class UniCrossEnv(TaskScene, EpisodeStarts, StepMath, TaskStateIO, BaseEnv):
         n = self.hand_spec.dof
         self.single_action_space = spaces.Box(-1.0, 1.0, (n,), dtype=np.float32)
         self.action_space = batch_space(self.single_action_space, self.num_envs)
-        # the thin step (``step``): the state observation and a dense reward, as training uses
-        self._thin_step = self._obs_mode == "state" and self._reward_mode in ("dense", "normalized_dense")
+        # the thin step (``step``): state observations and a dense reward, as training uses
+        self._thin_step = self._obs_mode in ("state", "state_dict") and \
+            self._reward_mode in ("dense", "normalized_dense")
+        self._obs_layout = obs_layout(observe(self, self._obs_terms))  # ManiSkill's __init__ has reset
         _freeze_heap_once()
 
 
@@ -259,11 +261,12 @@ class UniCrossEnv(TaskScene, EpisodeStarts, StepMath, TaskStateIO, BaseEnv):
 
     # ------------------------------------------------------------------ stepping
     def step(self, action):
-        """One control step. With the ``state`` observation and a dense reward (what training uses)
-        the step is thin: ManiSkill's substeps and hooks (``_step_action``) and ``get_info()`` run as
+        """One control step. With the ``state`` or ``state_dict`` observation and a dense reward (what
+        training and evaluation use) the step is thin: ManiSkill's substeps and hooks (``_step_action``) and ``get_info()`` run as
         in ``BaseEnv.step``, and the compiled step math already holds the flat observation, the
         reward sum, termination and the non-finite check (``StepMath._step_outputs``), so ManiSkill's
-        generic observation/reward assembly and flattening are skipped (equal results, tested).
+        generic observation/reward assembly and flattening are skipped (equal results, tested; a
+        ``state_dict`` observation is views into the flat one).
         Other observation and reward modes go through ``BaseEnv.step``."""
         a = common.to_tensor(action, device=self.device)
         if a.ndim == 1:
@@ -281,6 +284,8 @@ class UniCrossEnv(TaskScene, EpisodeStarts, StepMath, TaskStateIO, BaseEnv):
             self._elapsed_steps += 1
             info = self.get_info()
             obs, reward, terminated, truncated = self._step_out
+            if self._obs_mode == "state_dict":
+                obs = dict(agent=self._get_obs_agent(), extra=unflatten(obs, self._obs_layout))
             self._last_obs = obs
             return obs, reward, terminated, truncated, info
         obs, reward, _, _, info = super().step(None)

@@ -44,12 +44,12 @@ def test_state_dict_obs_mode(grasp_file):
 def test_thin_step_equals_maniskills_generic_step(task, kw, grasp_file):
     """The thin step (state observation, dense reward) returns what BaseEnv.step's generic assembly
     returns from the same episode: observation (ManiSkill's flattening of the observation dict),
-    reward, terminated, truncated and info, bit for bit, with randomisation (noise, pushes) live;
-    and the state_dict observation mode carries the same numbers."""
+    reward, terminated, truncated and info, bit for bit, with randomisation (noise, pushes) live,
+    for the state and the state_dict observation modes."""
     def run(thin, obs_mode="state"):
         env = make(task, grasp_file, randomize=True, obs_mode=obs_mode, **kw)
         u = env.unwrapped
-        assert u._thin_step == (obs_mode == "state")
+        assert u._thin_step
         u._thin_step = thin
         out = [u.reset(seed=5)]
         g = torch.Generator().manual_seed(2)
@@ -57,13 +57,17 @@ def test_thin_step_equals_maniskills_generic_step(task, kw, grasp_file):
             out.append(u.step((torch.rand(1, 22, generator=g) * 2 - 1) * 0.5))
         env.close()
         return out
-    thin, generic, as_dict = run(True), run(False), run(False, "state_dict")
+    thin, generic = run(True), run(False)
+    thin_dict, generic_dict = run(True, "state_dict"), run(False, "state_dict")
     from mani_skill.utils.common import flatten_state_dict
-    for i, (a, b, c) in enumerate(zip(thin, generic, as_dict)):
+    for i, (a, b, c, d) in enumerate(zip(thin, generic, thin_dict, generic_dict)):
         assert torch.equal(a[0], b[0]), f"observation differs at step {i}"
-        assert torch.equal(a[0], flatten_state_dict(c[0], use_torch=True)), f"state_dict differs at step {i}"
-        for x, y in zip(a[1:-1], b[1:-1]):
-            assert torch.equal(x, y)
+        for x, y in ((c[0], d[0]), (c[0]["extra"]["object"], d[0]["extra"]["object"])):
+            assert x.keys() == y.keys()
+        assert torch.equal(flatten_state_dict(c[0], use_torch=True), flatten_state_dict(d[0], use_torch=True))
+        assert torch.equal(a[0], flatten_state_dict(d[0], use_torch=True)), f"state_dict differs at step {i}"
+        for x, y, z in zip(a[1:-1], b[1:-1], c[1:-1]):
+            assert torch.equal(x, y) and torch.equal(x, z)
         info_a, info_b = a[-1], b[-1]
         assert info_a.keys() == info_b.keys()
         for k in info_a:

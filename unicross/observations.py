@@ -64,6 +64,20 @@ def observe_flat(env, terms: Dict[str, List[Callable]]) -> torch.Tensor:
     return torch.cat([fn(env).reshape(n, -1) for group in GROUPS for _, fn in terms[group]], dim=-1)
 
 
+def obs_layout(obs: dict) -> list:
+    """The widths of ``observe``'s output in ``observe_flat``'s order: ``[(group, width)]`` for the
+    hand and goal groups, ``[(group, [(term, width)])]`` for the object group."""
+    return [(g, [(n, x.shape[-1]) for n, x in obs[g].items()] if isinstance(obs[g], dict) else obs[g].shape[-1])
+            for g in GROUPS]
+
+
+def unflatten(flat: torch.Tensor, layout: list) -> dict:
+    """``observe``'s dict from ``observe_flat``'s tensor (views into it)."""
+    widths = [w for _, ws in layout for w in ([w for _, w in ws] if isinstance(ws, list) else [ws])]
+    parts = iter(torch.split(flat, widths, dim=-1))
+    return {g: {n: next(parts) for n, _ in ws} if isinstance(ws, list) else next(parts) for g, ws in layout}
+
+
 @observation_term("joint_pos")
 def joint_pos(env) -> torch.Tensor:
     """Actuated joint positions (virtual wrist + fingers) with the episode's reading noise."""
