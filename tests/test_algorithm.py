@@ -66,3 +66,14 @@ def test_kl_stop_and_state_round_trip():
     obs = [torch.randn(8, DIMS[k], generator=g) for k in OBS_KEYS]
     assert torch.equal(other.actor(*obs)[0], algo.actor(*obs)[0])
     assert other.lr == algo.lr
+
+
+def test_adaptive_rate_ignores_the_kl_of_the_updates_first_step():
+    """The first minibatch step of an update measures the policy that collected the batch (KL 0):
+    it must not move the rate. With every KL below half the threshold, each later step raises
+    it x1.5: 4 raises in 5 steps (before the fix 5; with kl_stop that pinned the rate at lr_max,
+    x1.5 at the first step and /1.5 at the stop)."""
+    algo = make_algo(lr=1.0e-5, kl_threshold=10.0, lr_max=1.0)
+    out = algo.update(bandit_batch(algo, torch.Generator().manual_seed(3)))
+    assert out["minibatch_steps"] == 5
+    assert out["lr"] == pytest.approx(1.0e-5 * 1.5 ** 4)

@@ -114,7 +114,7 @@ class PPO:
             if stopped:
                 break
             for _ in range(n_mb):
-                klv = self._step(self.rb.sample(), stats)
+                klv = self._step(self.rb.sample(), stats, first=count == 0)
                 count += 1
                 if kl_stop is not None and klv > kl_stop:  # the policy moved far enough for this batch
                     stopped = True
@@ -128,8 +128,11 @@ class PPO:
         out["value_mean"], out["value_std"] = float(vn.mean), float(vn.std())
         return out
 
-    def _step(self, mb: TensorDict, stats: dict) -> float:
-        """One minibatch gradient step; adds its diagnostics to ``stats``; returns its KL."""
+    def _step(self, mb: TensorDict, stats: dict, first: bool = False) -> float:
+        """One minibatch gradient step; adds its diagnostics to ``stats``; returns its KL. ``first``:
+        the update's first step, whose KL is measured on the policy that collected the batch (0 by
+        construction), so it does not move the adaptive rate (it would always raise it; with
+        ``kl_stop`` that pinned the rate at ``lr_max``: one step per update at the largest rate)."""
         oc = self.cfg["optim"]
         losses = self.loss(mb)
         loss = losses["loss_objective"] + losses["loss_critic"]
@@ -141,7 +144,8 @@ class PPO:
         gc = torch.nn.utils.clip_grad_norm_(self._critic_params, oc["max_grad_norm_critic"])
         self.optim.step()
         klv = float(losses["kl_approx"])
-        self._schedule_lr(klv)
+        if not first:
+            self._schedule_lr(klv)
         for k in LOSS_KEYS:
             if k in losses.keys():
                 stats[k] += float(losses[k].detach().float().mean())
