@@ -112,7 +112,7 @@ class StepMath:
     def _step_outputs(self, info: dict, elapsed_steps):
         """(state observation, dense reward, terminated, truncated) after the step, non-finite rows
         zeroed and truncated; sets ``info["nonfinite"]``."""
-        reward = sum(info[f"reward_{k}"] for k in self.rewards.names)
+        reward = self.dense_reward(info)
         obs = observe_flat(self, self._obs_terms)
         bad = ~torch.isfinite(reward) | ~torch.isfinite(obs).all(-1)
         info["nonfinite"] = bad
@@ -120,6 +120,10 @@ class StepMath:
         truncated = (elapsed_steps >= self.episode_length[self.mode]) | bad
         obs = torch.nan_to_num(obs, nan=0.0, posinf=0.0, neginf=0.0)
         return obs, torch.where(bad, torch.zeros_like(reward), reward), terminated, truncated
+
+    def dense_reward(self, info: dict) -> torch.Tensor:
+        """The dense reward: the sum of the reward terms in ``info``."""
+        return sum(info[f"reward_{k}"] for k in self.rewards.names)
 
     def _goal_errors(self, cur: F.Relational):
         """The object's position (m) and angle (rad) error to its final root-frame pose before and
