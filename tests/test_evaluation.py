@@ -78,6 +78,9 @@ def test_fail_fast(tmp_path):
         E.run_protocol("juggle", E.zero_policy, get_object_set("train", limit=1), progress=False)
     assert cli(["eval", "--policy", "zero", "--protocol", "juggle", "--out", str(tmp_path / "x.json")]) == 2
     assert cli(["eval", "--policy", "zero", "--objects", "nowhere", "--out", str(tmp_path / "x.json")]) == 2
+    assert cli(["eval", "--policy", "zero", "--protocol", "rotate", "--axis", "w+", "--out", str(tmp_path / "x.json")]) == 2
+    assert cli(["eval", "--policy", "zero", "--protocol", "grasp", "--axis", "z+", "--out", str(tmp_path / "x.json")]) == 2
+    assert not (tmp_path / "x.json").exists()
     assert cli(["eval", "--policy", str(tmp_path / "missing.pt"), "--out", str(tmp_path / "x.json")]) == 2
     # a checkpoint with the wrong observation size
     from unicross.rl.models import make_models
@@ -115,6 +118,14 @@ def test_cli_eval_gives_the_same_trials_on_any_number_of_workers(tmp_path, grasp
                     "--out", str(path)]) == 0
         out[w] = json.loads(path.read_text())["trials"]
     assert len(out[1]["translate"]) == 8 and out[1] == out[2]
+    # --axis runs a subset of the axes: each of its trials is the one the full protocol gives
+    path = tmp_path / "zneg.json"
+    assert cli(["eval", "--policy", "random", "--protocol", "translate", "--objects", "train", "--limit", "1",
+                "--trials-per-object", "2", "--grasps", str(grasp_file), "--axis", "z-", "--seed", "3",
+                "--out", str(path)]) == 0
+    r = json.loads(path.read_text())
+    assert r["axes"] == ["z-"] and r["trials"]["translate"] == [t for t in out[1]["translate"] if t["axis"] == "z-"]
+    assert r["summaries"]["translate"]["n"] == 4
 
 
 def test_eval_ablation_flags_checked_before_simulation(tmp_path, capsys):

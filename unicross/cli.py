@@ -289,6 +289,15 @@ def _cmd_eval(args) -> int:
     bad = [p for p in protocols if p not in E.PROTOCOLS]
     if bad:
         raise ValueError(f"unknown protocol(s) {bad}; valid: {list(E.PROTOCOLS)} or 'all'")
+    axes = args.axis.split(",") if args.axis else None
+    if axes:
+        with_axes = [p for p in protocols if E._axes(p) != [None]]
+        if not with_axes:
+            raise ValueError(f"--axis {args.axis}: none of the protocols {protocols} has axes (rotate and translate do)")
+        for p in with_axes:
+            bad = [a for a in axes if a not in E._axes(p)]
+            if bad:
+                raise ValueError(f"--axis {args.axis}: {bad} are not axes of protocol {p!r}: {E._axes(p)}")
     objs = get_object_set(args.objects, limit=args.limit)
     _, desc = E.resolve_policy(args.policy, args.hand, seed=args.seed)  # checks the checkpoint before simulating
     ablation = desc.get("ablation")
@@ -303,7 +312,7 @@ def _cmd_eval(args) -> int:
         ablation = {f: True for f in args.ablation}
     label = args.label or Path(args.policy).stem
     result = dict(label=label, policy=desc, objects=args.objects, limit=args.limit, hand=args.hand,
-                  trials_per_object=args.trials_per_object, seed=args.seed, disturb=args.disturb,
+                  trials_per_object=args.trials_per_object, seed=args.seed, axes=axes, disturb=args.disturb,
                   original=args.original, randomize=args.randomize, ablation=ablation or {}, summaries={}, trials={})
     out = Path(args.out)
     if args.resume and out.is_file():  # the protocols a stopped evaluation finished are kept
@@ -323,7 +332,7 @@ def _cmd_eval(args) -> int:
                                         randomize=args.randomize, grasp_dataset=args.grasps, original=args.original,
                                         videos=args.videos,
                                         video_dir=Path(args.out).parent / (Path(args.out).stem + "_videos"),
-                                        ablation=ablation)
+                                        ablation=ablation, **({"axes": axes} if axes and E._axes(p) != [None] else {}))
         result["trials"][p] = trials
         result["summaries"][p] = E.summarize(p, trials)
         _write_eval(out, result)  # each finished protocol is on disk before the next starts
@@ -498,6 +507,9 @@ def main(argv=None) -> int:
     s.add_argument("--limit", type=positive, default=None, help="first N objects per (category, type) group")
     s.add_argument("--trials-per-object", type=positive, default=load_config("eval")["trials_per_object"],
                    help="starts per object and axis (default: configs/eval.yaml, the paper's 25)")
+    s.add_argument("--axis", default=None,
+                   help="rotate/translate: only these axes (comma list, e.g. z+ or x+,x-; default: all of the "
+                        "protocol's); protocols without axes ignore it. " + axes_help)
     s.add_argument("--disturb", action="store_true", help="constant random force U[0, 10 m g] on the object")
     s.add_argument("--original", action="store_true",
                    help="baselines' original settings: no table (grasp), palm up and fixed wrist (rotate/translate)")
