@@ -27,6 +27,8 @@ def test_report_paper_one_trial(tmp_path):
     trials = E.run_protocol("relocate", E.zero_policy, get_object_set("test", limit=1), trials_per_object=1,
                             seed=0, progress=False)
     assert f"| relocate | zero | {_cell(E.summarize('relocate', trials), 'relocate')} |" in text
+    for mode in ("rotate_x+", "rotate_z-", "translate_z+", "translate_z-"):  # the bar of each in-hand expert
+        assert f"| {mode} | zero | " in text
 
 
 @pytest.mark.parametrize("argv,msg", [

@@ -123,8 +123,10 @@ class PaperReport:
         base = [("relocate", "scripted-relocate", self.evaluate("relocate", "scripted-relocate", "test")),
                 ("relocate", "zero", self.evaluate("relocate", "zero", "test")),
                 ("relocate", "zero (`--disturb`)", self.evaluate("relocate", "zero", "test", disturb=True))]
+        base += [(mode, "zero", self.evaluate(mode, "zero", "test")) for mode in F.MODES if mode_axis(mode)]
         lines += self._table("Baselines: the naive relocation and the zero action", base, "Gen. (Base.)",
-                             "Paper column: its retrained per-skill baselines (Gen.), not these.")
+                             "Paper column: its retrained per-skill baselines (Gen.), not these. The zero action "
+                             "on each rotate and translate axis is the bar its expert has to clear.")
         lines += ["## Long horizon", ""]
         if "student" not in self.ckpts:
             lines += ["Not run: needs the student (`unicross/checkpoints/<hand>/student.pt`), which is not "
