@@ -331,11 +331,10 @@ class UniCrossEnv(TaskScene, EpisodeStarts, StepMath, TaskStateIO, BaseEnv):
 
     # ------------------------------------------------------------------ evaluation (single source of truth)
     def _read(self):
-        """The step's reads from the simulator: tracked body poses (compiled on the CPU: the root and
-        the object, the links follow from the joint positions, ``HandObjectSensor.step_poses``), the
-        links' contact forces with the object (only after a physics step; otherwise the last ones are
-        kept), joint positions and velocities. Everything after the reads is tensor math (``_step_math``)."""
-        pos, quat = self.sensor.step_poses()
+        """The step's reads from the simulator: tracked body poses, the links' contact forces with the
+        object (only after a physics step; otherwise the last ones are kept), joint positions and
+        velocities. Everything after the reads is tensor math (``_step_math``)."""
+        pos, quat = self.sensor.poses()
         if self._stepped:
             self.link_force = torch.linalg.norm(self.sensor.contact_forces(), dim=-1)
             self._stepped = False

@@ -121,13 +121,6 @@ class TaskScene:
         self._closest_kinds = self.shape_kinds if not self._compiled else \
             frozenset({SHAPE_BOX, SHAPE_CYLINDER, SHAPE_SPHERE, SHAPE_PRISM} | ({SHAPE_MESH} if meshes else set()))
 
-    def _make_sensor(self, forward_kinematics: bool) -> HandObjectSensor:
-        """The reads of the step. Compiled on the CPU, the hand's link poses come from forward
-        kinematics inside the step graph (one root read instead of one read per link, ~50 us a
-        step); eagerly the ~200 ops of the kinematics cost more than the reads they replace."""
-        return HandObjectSensor(self.scene, self._hand_frame_link, self.contact_links, self.obj,
-                                articulation=self.agent.robot, forward_kinematics=forward_kinematics)
-
     def _after_reconfigure(self, options: dict):
         spec, robot, dev = self.hand_spec, self.agent.robot, self.device
         names = [j.name for j in robot.active_joints]
@@ -146,8 +139,7 @@ class TaskScene:
             shapes = l._objs[0].collision_shapes
             probe.append(np.mean([s.local_pose.p for s in shapes], axis=0) if shapes else np.zeros(3))
         self.link_probe = torch.tensor(np.array(probe), dtype=torch.float32, device=dev)
-        self._hand_frame_link = links[HAND_FRAME_LINK]
-        self.sensor = self._make_sensor(forward_kinematics=self._compiled)
+        self.sensor = HandObjectSensor(self.scene, links[HAND_FRAME_LINK], self.contact_links, self.obj)
         gains = self.agent.finger_gains
         self._finger_pd = tuple(torch.tensor([gains[j][k] for j in spec.finger_joints], device=dev)
                                 for k in range(3))

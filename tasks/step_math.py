@@ -49,7 +49,6 @@ class StepMath:
         return step
 
     def _measure(self, pos, quat, force, qpos, qvel) -> Dict[str, torch.Tensor]:
-        pos, quat = self.sensor.complete(pos, quat, qpos)  # the link poses, if the read left them out
         hand_p, hand_q = pos[:, 0], quat[:, 0]
         link_p, link_q = pos[:, 1:-1], quat[:, 1:-1]
         obj_p, obj_q = pos[:, -1], quat[:, -1]

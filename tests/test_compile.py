@@ -50,12 +50,8 @@ def _compare(task, kw, grasp_file):
     eager_state = dict(vars(u))
     vars(u).update(saved)
     u._closest_kinds = frozenset(range(4))  # as when compiling: every primitive's formula, selected per env
-    # ... and as when compiling on the CPU: the hand's link poses by forward kinematics in the graph
-    u.sensor = u._make_sensor(forward_kinematics=True)
-    fk_reads = u._read()
-    assert fk_reads[0].shape[1] == 2 and reads[0].shape[1] == 2 + len(u.contact_links)
     compiled = torch.compile(u._step_math_eager, fullgraph=True, dynamic=False, options=CPU_OPTIONS)
-    info, out = compiled(*fk_reads, u.elapsed_steps, noise)
+    info, out = compiled(*reads, u.elapsed_steps, noise)
     assert info.keys() == eager_info.keys()
     for name, got, want in zip(("obs", "reward", "terminated", "truncated"), out, eager_out):
         torch.testing.assert_close(got, want, atol=1e-5, rtol=1e-5, msg=lambda m: f"{task} {name}: {m}")

@@ -3,12 +3,6 @@
 Both backends return the same tensors on the env device:
   * ``poses()``           -> positions [N, B, 3] and quaternions [N, B, 4] of the tracked bodies
                              (hand frame, contact links, object), one gather per step;
-  * ``step_poses()`` and ``complete(pos, quat, qpos)`` -> the same in two halves: the read, and
-                             tensor math that runs inside the compiled step. With
-                             ``forward_kinematics`` (CPU) the read is the articulation root and
-                             the object only, and ``complete`` derives the hand's links from the
-                             joint positions (:mod:`unicross.kinematics`); otherwise it is ``poses()``
-                             and ``complete`` returns it unchanged;
   * ``contact_forces()``  -> net contact force vector between each contact link and the object,
                              [N, L, 3], in Newtons;
   * ``apply_object_force(f)`` applies an external force to the object for the next sim step.
@@ -23,14 +17,10 @@ from typing import List
 import numpy as np
 import torch
 
-from unicross.kinematics import ArticulationFK
-
 
 class HandObjectSensor:
-    def __init__(self, scene, hand_frame, links: List, obj, articulation=None, forward_kinematics: bool = False):
-        """hand_frame and links are ManiSkill ``Link`` structs of ``articulation`` (an ``Articulation``
-        struct), obj an ``Actor`` struct. ``forward_kinematics`` (CPU only; ignored on the GPU, where
-        one gather reads every pose): the hand's poses come from its joint positions."""
+    def __init__(self, scene, hand_frame, links: List, obj):
+        """hand_frame and links are ManiSkill ``Link`` structs, obj an ``Actor`` struct."""
         self.scene = scene
         self.device = scene.device
         self.gpu = scene.gpu_sim_enabled
@@ -48,10 +38,6 @@ class HandObjectSensor:
             self._obj_body = obj._bodies[0]
             self._zero3 = np.zeros(3, dtype=np.float32)
         self._num_bodies = len(bodies)
-        self.fk = None
-        if forward_kinematics and not self.gpu:
-            self._art = articulation._objs[0]
-            self.fk = ArticulationFK(self._art, self._components[:-1], self.device)
 
     def poses(self):
         if self.gpu:
@@ -62,24 +48,6 @@ class HandObjectSensor:
         p = torch.from_numpy(np.array([x.p for x in poses], dtype=np.float32))[None]
         q = torch.from_numpy(np.array([x.q for x in poses], dtype=np.float32))[None]
         return p, q
-
-    def step_poses(self):
-        """What :meth:`complete` needs: with forward kinematics, the positions [1, 2, 3] and
-        quaternions [1, 2, 4] of the articulation's root and of the object; else :meth:`poses`."""
-        if self.fk is None:
-            return self.poses()
-        poses = (self._art.root_pose, self._obj_body.entity_pose)
-        p = torch.from_numpy(np.array([x.p for x in poses], dtype=np.float32))[None]
-        q = torch.from_numpy(np.array([x.q for x in poses], dtype=np.float32))[None]
-        return p, q
-
-    def complete(self, pos: torch.Tensor, quat: torch.Tensor, qpos: torch.Tensor):
-        """:meth:`step_poses`'s output and the joint positions [N, dof] -> :meth:`poses`'s output
-        (pure tensor math, traced into the compiled step)."""
-        if self.fk is None:
-            return pos, quat
-        lp, lq = self.fk(pos[:, 0], quat[:, 0], qpos)
-        return torch.cat([lp, pos[:, 1:]], dim=1), torch.cat([lq, quat[:, 1:]], dim=1)
 
     def contact_forces(self) -> torch.Tensor:
         dt = self.scene.px.timestep
