@@ -276,7 +276,9 @@ class UniCrossEnv(TaskScene, EpisodeStarts, StepMath, TaskStateIO, BaseEnv):
         a = a.float()
         if not torch.isfinite(a).all():
             raise ValueError("action contains NaN or inf")
-        self._apply_command(self._command_math(a, self.elapsed_steps))
+        targets, forces = self._command_math(a, self.elapsed_steps, *self._draw_perturbation())
+        self._apply_command(targets)
+        self._forces = None if forces is None else forces if self.gpu_sim_enabled else list(forces[:, 0].numpy())
         self._pending = torch.ones_like(self._pending)  # evaluate() advances targets once per step
         self._stepped = True
         if self._thin_step:
@@ -296,33 +298,21 @@ class UniCrossEnv(TaskScene, EpisodeStarts, StepMath, TaskStateIO, BaseEnv):
             obs = _map_tensors(obs, lambda x: torch.nan_to_num(x, nan=0.0, posinf=0.0, neginf=0.0))
         return obs, reward, terminated, truncated, info
 
-    def _before_control_step(self):
-        """This control step's external object forces for all substeps at once: the decaying random
-        perturbation (domain randomisation) plus the constant disturbance of the robustness protocol
-        (for grasp only while lifting)."""
+    def _draw_perturbation(self):
+        """The random draws of this control step's object perturbation (``StepMath._object_forces``
+        turns them into forces inside the compiled command math): standard normals [k, N, 3] and
+        uniforms [k, N, 1], or ``(None, None)`` when the perturbation is off."""
         rc = self.cfg["randomization"]
+        if not (rc["enabled"] and rc["perturb_scale"] > 0):
+            return None, None
         k, n = self._sim_steps_per_control, self.num_envs
+        return (torch.randn(k, n, 3, generator=self._gen, device=self.device),
+                torch.rand(k, n, 1, generator=self._gen, device=self.device))
+
+    def _before_control_step(self):
+        """The substeps of this control step apply ``self._forces`` (set by ``step`` from the
+        command math) one by one."""
         self._substep = 0
-        self._forces = None
-        forces = None
-        if rc["enabled"] and rc["perturb_scale"] > 0:
-            new = rc["perturb_scale"] * self.obj_mass[:, None] * torch.randn(k, n, 3, generator=self._gen, device=self.device)
-            redraw = torch.rand(k, n, 1, generator=self._gen, device=self.device) < rc["perturb_prob"]
-            f, steps = self.perturb, []
-            for i in range(k):  # the decay recursion over the substeps of one control step
-                f = torch.where(redraw[i], new[i], f * rc["perturb_decay"])
-                steps.append(f)
-            self.perturb = f
-            forces = torch.stack(steps)
-        if self.cfg["disturbance"]["max_scale"] > 0:
-            active = torch.ones(n, 1, dtype=torch.bool, device=self.device)
-            lift_after = self.cfg["grasp"]["lift_after"]
-            if lift_after is not None:
-                active = (~self._lifts[self.mode] | (self.elapsed_steps >= lift_after))[:, None]
-            disturb = torch.where(active, self.disturb, torch.zeros_like(self.disturb))
-            forces = disturb.expand(k, n, 3) if forces is None else forces + disturb
-        if forces is not None:
-            self._forces = forces if self.gpu_sim_enabled else list(forces[:, 0].numpy())
 
     def _before_simulation_step(self):
         if self._forces is not None:

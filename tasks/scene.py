@@ -195,6 +195,7 @@ class TaskScene:
         self.lift = z3.clone()
         self.perturb = z3.clone()
         self.disturb = z3.clone()
+        self._forces = None  # this control step's object forces per substep (set by step())
         self.obs_noise = torch.zeros(n, dof, device=dev)
         self.obj_vel_h = z3.clone()
         self.obj_angvel_h = z3.clone()

@@ -24,16 +24,46 @@ from unicross.geometry import (
 class StepMath:
     """Per-step math of the UniCross task (a mixin of ``UniCrossEnv``)."""
 
-    def _command_math_eager(self, a: torch.Tensor, elapsed_steps: torch.Tensor) -> torch.Tensor:
+    def _command_math_eager(self, a: torch.Tensor, elapsed_steps: torch.Tensor, perturb_normal=None,
+                            perturb_uniform=None):
         """The normalised action [-1, 1] -> this step's joint command (``self.command``; the wrist
         reference is the target hand pose, raised during the grasp lift) -> the drive targets of all
-        driven joints. Pure tensor math on the task state, compiled like ``_step_math_eager``."""
+        driven joints; and the external forces on the object for this step's substeps
+        (:meth:`_object_forces`, from the draws of ``UniCrossEnv._draw_perturbation``). Pure tensor
+        math on the task state, compiled like ``_step_math_eager``. Returns ``(targets, forces)``."""
         a = a.clamp(-1.0, 1.0)
         ref = F.wrist_reference(self.targets)
         ref[:, :3] = ref[:, :3] + self._advance_lift(elapsed_steps)
         self.command = F.map_action(a, self.command, ref, self.action_scale, self.q_lower, self.q_upper,
                                     wrist_from_target=not self.cfg["ablation"]["no_target_action"])
-        return self._drive_targets()
+        return self._drive_targets(), self._object_forces(elapsed_steps, perturb_normal, perturb_uniform)
+
+    def _object_forces(self, elapsed_steps: torch.Tensor, normal, uniform):
+        """This control step's external object forces for all substeps [k, N, 3] (None: none): the
+        decaying random perturbation of domain randomisation (a new force ``scale * m * normal`` with
+        probability ``perturb_prob`` per substep, else the last one times ``perturb_decay``; state
+        ``self.perturb``) plus the constant disturbance of the robustness protocol (for grasp only
+        while lifting)."""
+        rc = self.cfg["randomization"]
+        k, n = self._sim_steps_per_control, self.num_envs
+        forces = None
+        if normal is not None:
+            new = rc["perturb_scale"] * self.obj_mass[:, None] * normal
+            redraw = uniform < rc["perturb_prob"]
+            f, steps = self.perturb, []
+            for i in range(k):  # the decay recursion over the substeps of one control step
+                f = torch.where(redraw[i], new[i], f * rc["perturb_decay"])
+                steps.append(f)
+            self.perturb = f
+            forces = torch.stack(steps)
+        if self.cfg["disturbance"]["max_scale"] > 0:
+            active = torch.ones(n, 1, dtype=torch.bool, device=self.device)
+            lift_after = self.cfg["grasp"]["lift_after"]
+            if lift_after is not None:
+                active = (~self._lifts[self.mode] | (elapsed_steps >= lift_after))[:, None]
+            disturb = torch.where(active, self.disturb, torch.zeros_like(self.disturb))
+            forces = disturb.expand(k, n, 3) if forces is None else forces + disturb
+        return forces
 
     def _advance_lift(self, elapsed_steps: torch.Tensor) -> torch.Tensor:
         """Grasp lift phase: the wrist reference (the Free current wrist pose) rises by

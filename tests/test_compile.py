@@ -34,12 +34,19 @@ def _compare(task, kw, grasp_file):
         u.step((torch.rand(1, u.hand_spec.dof, generator=g) * 2 - 1) * 0.5)
     # the action -> joint command math
     a = (torch.rand(1, u.hand_spec.dof, generator=g) * 2 - 1) * 0.5
+    draws = u._draw_perturbation()
+    assert draws[0] is not None  # randomisation on: the perturbation forces are part of the math
     saved = dict(vars(u))
-    eager_targets, eager_command = u._command_math_eager(a, u.elapsed_steps), u.command
+    (eager_targets, eager_forces), eager_command, eager_perturb = u._command_math_eager(a, u.elapsed_steps, *draws), \
+        u.command, u.perturb
     vars(u).update(saved)
-    targets = torch.compile(u._command_math_eager, fullgraph=True, dynamic=False, options=CPU_OPTIONS)(a, u.elapsed_steps)
+    targets, forces = torch.compile(u._command_math_eager, fullgraph=True, dynamic=False,
+                                    options=CPU_OPTIONS)(a, u.elapsed_steps, *draws)
     torch.testing.assert_close(targets, eager_targets, atol=1e-5, rtol=1e-5)
+    torch.testing.assert_close(forces, eager_forces, atol=1e-5, rtol=1e-5)
+    assert float(forces.abs().max()) > 0
     torch.testing.assert_close(u.command, eager_command, atol=1e-5, rtol=1e-5)
+    torch.testing.assert_close(u.perturb, eager_perturb, atol=1e-5, rtol=1e-5)
     vars(u).update(saved)
     # the math after the reads
     u._pending = torch.ones_like(u._pending)  # as right after a physics step
