@@ -8,9 +8,11 @@ training W:  ``unicross train``'s loop (lean collector with W worker processes, 
 efficiency:  training W / (W x single env)  (target: >= 0.8 at 2 workers, issue "Training at the
              speed of physics").
 
-Writes JSON (``--json``) and a PNG curve (``--png``).
+Writes JSON (``--json``) and a PNG curve (``--png``). ``--set section.key=value`` overrides
+``configs/ppo.yaml`` as ``unicross train --set`` does (e.g. the in-hand experts' 4096-frame batches
+and ``optim.kl_stop``), for the training rows only.
 
-    python benchmarks/scaling.py [--workers 1 2] [--iterations 4] [--json docs/scaling.json] [--png docs/scaling.png]
+    python benchmarks/scaling.py [--workers 1 2] [--iterations 4] [--set ...] [--json docs/scaling.json] [--png docs/scaling.png]
 """
 from __future__ import annotations
 
@@ -27,6 +29,7 @@ sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 import gymnasium as gym  # noqa: E402
 
 import unicross  # noqa: E402,F401
+from unicross.cli import parse_sets  # noqa: E402
 from unicross.rl.ppo import PPOTrainer  # noqa: E402
 
 
@@ -49,11 +52,18 @@ def single_env_rate(steps: int, seed: int = 0) -> float:
     return rate
 
 
-def training_rate(workers: int, iterations: int) -> dict:
+def _merge(a: dict, b: dict) -> dict:
+    out = dict(a)
+    for k, v in b.items():
+        out[k] = _merge(out[k], v) if isinstance(v, dict) and isinstance(out.get(k), dict) else v
+    return out
+
+
+def training_rate(workers: int, iterations: int, overrides: dict | None = None) -> dict:
     run = os.path.join(tempfile.mkdtemp(), "r")
-    t = PPOTrainer(run, "grasp", progress=False,
-                   overrides=dict(env=dict(num_envs=workers), collector=dict(total_frames=10 ** 9),
-                                  logging=dict(eval_trials=0, final_eval_trials=0, checkpoint_every=10 ** 6)))
+    base = dict(env=dict(num_envs=workers), collector=dict(total_frames=10 ** 9),
+                logging=dict(eval_trials=0, final_eval_trials=0, checkpoint_every=10 ** 6))
+    t = PPOTrainer(run, "grasp", progress=False, overrides=_merge(overrides or {}, base))
     try:
         t.train(max_iterations=1, eval_at_ends=False)  # warm up (first batch fits the statistics)
         f0, t0 = t.frames, time.perf_counter()
@@ -65,7 +75,8 @@ def training_rate(workers: int, iterations: int) -> dict:
     finally:
         t.close()
     return dict(workers=workers, frames_per_iteration=t.collector.frames_per_batch, training_fps=round(fps, 1),
-                collect_share=round(coll / (coll + upd), 3), update_share=round(upd / (coll + upd), 3))
+                collect_share=round(coll / (coll + upd), 3), update_share=round(upd / (coll + upd), 3),
+                minibatch_steps=round(sum(r["minibatch_steps"] for r in rows) / len(rows), 1))
 
 
 def main():
@@ -73,17 +84,18 @@ def main():
     p.add_argument("--workers", type=int, nargs="+", default=[1, 2])
     p.add_argument("--iterations", type=int, default=4)
     p.add_argument("--env-steps", type=int, default=1500)
+    p.add_argument("--set", action="append", metavar="SECTION.KEY=VALUE", help="override configs/ppo.yaml")
     p.add_argument("--json", default=None)
     p.add_argument("--png", default=None)
     args = p.parse_args()
     single = single_env_rate(args.env_steps)
     rows = []
     for w in args.workers:
-        r = training_rate(w, args.iterations)
+        r = training_rate(w, args.iterations, parse_sets(args.set))
         r["efficiency"] = round(r["training_fps"] / (w * single), 3)
         rows.append(r)
         print(json.dumps(r), flush=True)
-    out = dict(single_env_steps_per_s=round(single, 1), cores=os.cpu_count(), rows=rows)
+    out = dict(single_env_steps_per_s=round(single, 1), cores=os.cpu_count(), settings=args.set or [], rows=rows)
     print(json.dumps(out, indent=1))
     if args.json:
         with open(args.json, "w") as f:
