@@ -39,6 +39,9 @@ def single_env_rate(steps: int, seed: int = 0) -> float:
     u = env.unwrapped
     g = torch.Generator().manual_seed(seed)
     u.reset(seed=seed)
+    for _ in range(20):  # warm up: the first step compiles (or loads) the command math
+        u.step(torch.zeros(1, u.hand_spec.dof))
+    u.reset(seed=seed)
     n = 0
     t0 = time.perf_counter()
     while n < steps:
