@@ -30,6 +30,7 @@ import gymnasium as gym  # noqa: E402
 
 import unicross  # noqa: E402,F401
 from unicross.cli import parse_sets  # noqa: E402
+from unicross.config import deep_merge  # noqa: E402
 from unicross.rl.ppo import PPOTrainer  # noqa: E402
 
 
@@ -55,18 +56,11 @@ def single_env_rate(steps: int, seed: int = 0) -> float:
     return rate
 
 
-def _merge(a: dict, b: dict) -> dict:
-    out = dict(a)
-    for k, v in b.items():
-        out[k] = _merge(out[k], v) if isinstance(v, dict) and isinstance(out.get(k), dict) else v
-    return out
-
-
 def training_rate(workers: int, iterations: int, overrides: dict | None = None) -> dict:
     run = os.path.join(tempfile.mkdtemp(), "r")
     base = dict(env=dict(num_envs=workers), collector=dict(total_frames=10 ** 9),
                 logging=dict(eval_trials=0, final_eval_trials=0, checkpoint_every=10 ** 6))
-    t = PPOTrainer(run, "grasp", progress=False, overrides=_merge(overrides or {}, base))
+    t = PPOTrainer(run, "grasp", progress=False, overrides=deep_merge(overrides or {}, base, strict=False))
     try:
         t.train(max_iterations=1, eval_at_ends=False)  # warm up (first batch fits the statistics)
         f0, t0 = t.frames, time.perf_counter()

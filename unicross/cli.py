@@ -289,15 +289,16 @@ def _cmd_eval(args) -> int:
     bad = [p for p in protocols if p not in E.PROTOCOLS]
     if bad:
         raise ValueError(f"unknown protocol(s) {bad}; valid: {list(E.PROTOCOLS)} or 'all'")
+    from unicross.registry import SKILLS
     axes = args.axis.split(",") if args.axis else None
+    with_axes = [p for p in protocols if SKILLS[p].axes]
     if axes:
-        with_axes = [p for p in protocols if E._axes(p) != [None]]
         if not with_axes:
             raise ValueError(f"--axis {args.axis}: none of the protocols {protocols} has axes (rotate and translate do)")
         for p in with_axes:
-            bad = [a for a in axes if a not in E._axes(p)]
+            bad = [a for a in axes if a not in SKILLS[p].axes]
             if bad:
-                raise ValueError(f"--axis {args.axis}: {bad} are not axes of protocol {p!r}: {E._axes(p)}")
+                raise ValueError(f"--axis {args.axis}: {bad} are not axes of protocol {p!r}: {list(SKILLS[p].axes)}")
     objs = get_object_set(args.objects, limit=args.limit)
     _, desc = E.resolve_policy(args.policy, args.hand, seed=args.seed)  # checks the checkpoint before simulating
     ablation = desc.get("ablation")
@@ -332,7 +333,7 @@ def _cmd_eval(args) -> int:
                                         randomize=args.randomize, grasp_dataset=args.grasps, original=args.original,
                                         videos=args.videos,
                                         video_dir=Path(args.out).parent / (Path(args.out).stem + "_videos"),
-                                        ablation=ablation, **({"axes": axes} if axes and E._axes(p) != [None] else {}))
+                                        ablation=ablation, **({"axes": axes} if axes and p in with_axes else {}))
         result["trials"][p] = trials
         result["summaries"][p] = E.summarize(p, trials)
         _write_eval(out, result)  # each finished protocol is on disk before the next starts
