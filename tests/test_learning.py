@@ -44,6 +44,17 @@ def test_paper_reward_pays_hovering_more_than_grasping():
     assert [r.behaviour for r in rows] == ["hover", "scripted"]
 
 
+def test_translate_audit_pays_sliding_the_object_out_more_than_holding_still():
+    """Opening the fingers slides the object out along them (a physical translate z+): with our
+    success bonus it out-earns holding still; with the paper's coefficients it did not (the
+    measurement that set ``success.translate``)."""
+    ours = audit("translate", "z+", limit=1, seeds=1, progress=False, only=["open", "zero"])
+    assert [r.behaviour for r in ours] == ["open", "zero"] and ours[0].success > 0
+    paper = audit("translate", "z+", limit=1, seeds=1, progress=False, only=["open", "zero"],
+                  ppo_overrides=load_preset("paper_reward"))
+    assert [r.behaviour for r in paper] == ["zero", "open"]
+
+
 def test_random_rotate_returns_are_bounded_and_finite():
     env = gym.make("UniCross-Rotate-v1", axis="x+", config=dict(terminate_on_drop=False), **ENV)
     u = env.unwrapped

@@ -21,12 +21,16 @@ tightened by 0.1 rad, as the naive baseline holds them), ``naive`` (the paper's 
 wrist driven straight to the goal, fingers tightened), ``stay`` (the wrist holds its start pose)
 and ``random``.
 
-Rotate and translate: ``oracle``, ``zero``, ``random``. The oracle is a kinematic reference:
+Rotate and translate: ``oracle``, ``zero``, ``open``, ``close``, ``random``. The oracle is a kinematic reference:
 the hand holds still (zero action) and, after each control step's physics, the object is placed
 in the hand advanced by the mode's own speed (``omega_max`` about the hand-frame axis through
 the object's centre, or ``v_max`` along it) with zero velocity. The reward then measures the
 motion the mode asks for, exactly, with the contacts the physics produced: what the reward
-would pay a policy that does the skill.
+would pay a policy that does the skill. ``open`` and ``close`` are physical references: the
+finger targets move steadily along the hand's opening (closing) direction, 0.02 rad per control
+step at most per joint, the wrist holding still. Opening the fingers slides a grasped object out
+along the fingers (translate z+: 8/8 successes palm up and from random wrist orientations on
+train objects), so it is the successful reference that translate z+ must rank first.
 """
 from __future__ import annotations
 
@@ -96,6 +100,22 @@ def _naive_relocate(u):
     return lambda: scripted_relocate_policy(None, u)
 
 
+def _finger_sweep(rate: float):
+    """Finger targets move ``rate`` rad per control step along the closing direction (negative:
+    opening), scaled so the fastest joint moves ``|rate|``; the wrist residual is zero."""
+    def make(u):
+        from unicross.scripted_grasp import closing_delta
+        d = closing_delta(u.hand_spec).to(u.device)
+        step = rate * d / d.abs().max().clamp(min=1e-6)
+
+        def act():
+            a = torch.zeros(u.num_envs, u.hand_spec.dof, device=u.device)
+            a[:, 6:] = (step / u.action_scale[6:]).clamp(-1.0, 1.0)
+            return a
+        return act
+    return make
+
+
 def _oracle(u):
     """Kinematic in-hand motion (see the module docstring); installs a per-instance hook that
     :func:`audit` removes after the episode."""
@@ -137,7 +157,8 @@ def behaviours(skill: str, seed: int = 0) -> Dict[str, Callable]:
         return dict(follow=_zero, follow_tight=_follow_relocate, naive=_naive_relocate, stay=_stay,
                     random=common["random"])
     if skill in ("rotate", "translate"):
-        return dict(oracle=_oracle, **common)
+        return dict(oracle=_oracle, zero=common["zero"], open=_finger_sweep(-0.02), close=_finger_sweep(0.02),
+                    random=common["random"])
     raise ValueError(f"unknown skill {skill!r}; valid: grasp, relocate, rotate, translate")
 
 
