@@ -12,7 +12,7 @@ import argparse
 import time
 from pathlib import Path
 
-from unicross.audit import audit, behaviours, format_rows
+from unicross.audit import audit, behaviours, format_rows, physical_reference
 from unicross.config import load_preset
 from unicross.registry import SKILLS
 
@@ -49,10 +49,17 @@ def main(argv=None) -> int:
             title = f"{skill}{' ' + axis if axis else ''}"
             lines += [f"## {title}: {label} coefficients (reference `{ref}` ranks {rank}/{len(rows)}; "
                       f"{time.time() - t0:.0f} s)", "", format_rows(rows), ""]
-            verdict.append(f"| {title} | {label} | {rank} of {len(rows)} | {rows[0].behaviour} |")
+            names = [r.behaviour for r in rows]
+            phys = physical_reference(skill, axis)
+            phys_cell = f"`{phys}` {1 + names.index(phys)} (zero {1 + names.index('zero')})" if phys in names else "--"
+            verdict.append(f"| {title} | {label} | {rank} of {len(rows)} | {phys_cell} | {rows[0].behaviour} |")
             print(f"{title} ({label}): reference {ref} ranks {rank}/{len(rows)}", flush=True)
-    summary = ["## Summary", "", "| mode | coefficients | rank of the successful reference | first |",
-               "|---|---|---|---|"] + verdict + [""]
+    summary = ["## Summary", "",
+               "The successful reference is the first behaviour of each mode (in-hand: the kinematic oracle). "
+               "A physical reference (`unicross.audit.physical_reference`) does the mode through the physics "
+               "alone; it must out-earn the zero action.", "",
+               "| mode | coefficients | rank of the successful reference | physical reference rank (zero's) | first |",
+               "|---|---|---|---|---|"] + verdict + [""]
     Path(args.out).parent.mkdir(parents=True, exist_ok=True)
     Path(args.out).write_text("\n".join(lines[:4] + summary + lines[4:]) + "\n")
     print(f"wrote {args.out}")

@@ -144,6 +144,12 @@ def _oracle(u):
     return _zero(u)
 
 
+def physical_reference(skill: str, axis: Optional[str]) -> Optional[str]:
+    """The behaviour that does the mode through the physics alone (no kinematic help), where one is
+    known: it must out-earn holding still for PPO to have a reason to find it."""
+    return "open" if (skill, axis) == ("translate", "z+") else None
+
+
 def behaviours(skill: str, seed: int = 0) -> Dict[str, Callable]:
     """name -> factory(u) -> act() for the reference behaviours of ``skill``; the first is the
     successful reference."""
