@@ -4,7 +4,7 @@ import pytest
 import torch
 from torchrl.data import Bounded
 
-from unicross.rl.collector import LeanCollector
+from unicross.rl.collector import LeanCollector, one_thread
 from unicross.rl.models import make_models
 
 KW = dict(object_limit=1, reconfiguration_freq=1, config={"terminate_on_drop": False})  # episodes end at 64 steps
@@ -55,6 +55,19 @@ def test_workers_act_with_current_weights(num_envs):
             assert not torch.equal(data["hand"][0, 0], data["hand"][1, 0])
     finally:
         c.close()
+
+
+def test_one_thread_holds_one_thread_and_restores_the_count():
+    before = torch.get_num_threads()
+    torch.set_num_threads(2)
+    try:
+        with pytest.raises(KeyError):
+            with one_thread():
+                assert torch.get_num_threads() == 1
+                raise KeyError("the count comes back on errors too")
+        assert torch.get_num_threads() == 2
+    finally:
+        torch.set_num_threads(before)
 
 
 def test_worker_errors_are_raised_in_the_main_process():
