@@ -118,6 +118,7 @@ class StepMath:
         self._advance_motion(cur, pend, axis_prev)
         # reward compares against the targets the last action aimed at; Free targets = current
         reward_targets = F.with_free_as_current(self.mode, self.targets, cur)
+        held = ~self.ever_dropped  # before this step's drop test
         drop = self._drop(m["link_distance"], elapsed_steps)
         self._advance_targets(cur, pend)
         success, contact, lifted, pos_err, rot_err = self._success(m, skill)
@@ -128,7 +129,7 @@ class StepMath:
         meas = dict(link_distance=m["link_distance"], contact=contact, force_clipped=force_c, speed_along_axis=speed,
                     speed_cap=self._speed_cap[self.mode], relational=cur, reward_targets=reward_targets,
                     finger_qpos=m["qpos"][:, 6:], finger_qpos0=self.finger_q0, hand_lin_vel=self.hand_vel,
-                    hand_ang_vel=self.hand_angvel, finger_torque=m["finger_torque"], drop=drop, success=success,
+                    hand_ang_vel=self.hand_angvel, finger_torque=m["finger_torque"], drop=drop, held=held, success=success,
                     goal_err_prev=goal_err_prev, goal_err=goal_err)
         terms = self.rewards(self.mode, meas)
         self._observation_parts(m, cur, contact, force_c)

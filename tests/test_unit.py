@@ -113,7 +113,7 @@ def measurements(n: int, L: int = 5, seed: int = 0) -> dict:
                 relational=rel, reward_targets=rel.clone(), finger_qpos=torch.randn(n, 16, generator=g),
                 finger_qpos0=torch.randn(n, 16, generator=g), hand_lin_vel=torch.randn(n, 3, generator=g),
                 hand_ang_vel=torch.randn(n, 3, generator=g), finger_torque=torch.randn(n, 16, generator=g),
-                drop=torch.rand(n, generator=g) > 0.8)
+                drop=torch.rand(n, generator=g) > 0.8, held=torch.ones(n, dtype=torch.bool))
 
 
 def test_every_registered_term_is_computed_finite_and_per_env():
@@ -150,7 +150,10 @@ def test_contact_distance_saturates_and_motion_is_capped():
     fast = RW.motion_reward(dict(m, speed_along_axis=torch.tensor([5.0, -5.0])), cm, mode)
     w = cm["w_p"][mode[0]]
     assert fast[0].item() == pytest.approx(float(w * 0.1))  # capped at v_max
-    assert fast[1].item() == pytest.approx(float(w * -5.0))  # not bounded below (see README, translate)
+    assert fast[1].item() == pytest.approx(float(w * -5.0))  # not bounded below while held (paper)
+    lost = RW.motion_reward(dict(m, speed_along_axis=torch.tensor([5.0, -5.0]), held=torch.zeros(2, dtype=torch.bool)),
+                            cm, mode)
+    assert torch.equal(lost, torch.zeros(2))  # nothing after a drop: the paper's episode would have ended
 
 
 def test_progress_term_telescopes_to_the_error_reduction():

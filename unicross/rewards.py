@@ -77,8 +77,12 @@ def contact_reward(m: dict, c: dict, mode: torch.Tensor) -> torch.Tensor:
 
 @reward_term("motion", lambda cfg, dev: dict(w_p=per_mode(cfg["motion"], dev)))
 def motion_reward(m: dict, c: dict, mode: torch.Tensor) -> torch.Tensor:
-    """w_p · min(v_o^h · d^h, v_max)."""
-    return c["w_p"][mode] * torch.minimum(m["speed_along_axis"], m["speed_cap"])
+    """w_p · min(v_o^h · d^h, v_max) while the object is held (``held``: not dropped before this
+    step). The paper ends an episode at a drop, so it never pays motion after one; our training
+    episodes go on past drops (``terminate_on_drop: false``), and a lost object falling at 1-3 m/s
+    along the axis made this unbounded-below term -10 to -30 per step (translate), noise far
+    larger than anything a held object earns."""
+    return c["w_p"][mode] * torch.minimum(m["speed_along_axis"], m["speed_cap"]) * m["held"].float()
 
 
 @reward_term("success", lambda cfg, dev: dict(w=per_mode(cfg["success"], dev)))
