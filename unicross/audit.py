@@ -30,7 +30,7 @@ would pay a policy that does the skill. ``open`` and ``close`` are physical refe
 finger targets move steadily along the hand's opening (closing) direction, 0.02 rad per control
 step at most per joint, the wrist holding still. Opening the fingers slides a grasped object out
 along the fingers (translate z+: 8/8 successes palm up and from random wrist orientations on
-train objects), so it is the successful reference that translate z+ must rank first.
+train objects), so translate z+ must pay it more than holding still (:func:`physical_reference`).
 """
 from __future__ import annotations
 
