@@ -104,9 +104,8 @@ def _finger_sweep(rate: float):
     """Finger targets move ``rate`` rad per control step along the closing direction (negative:
     opening), scaled so the fastest joint moves ``|rate|``; the wrist residual is zero."""
     def make(u):
-        from unicross.scripted_grasp import closing_delta
-        d = closing_delta(u.hand_spec).to(u.device)
-        step = rate * d / d.abs().max().clamp(min=1e-6)
+        from unicross.scripted_grasp import closing_direction
+        step = rate * closing_direction(u.hand_spec).to(u.device)
 
         def act():
             a = torch.zeros(u.num_envs, u.hand_spec.dof, device=u.device)

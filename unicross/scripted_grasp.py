@@ -35,6 +35,13 @@ def closing_delta(hand_spec) -> torch.Tensor:
     return torch.from_numpy(hand_spec.closing_deltas())
 
 
+def closing_direction(hand_spec) -> torch.Tensor:
+    """:func:`closing_delta` scaled so its largest joint increment is 1 (rad): multiply by a step
+    in rad to move every finger joint along the hand's closing direction, the fastest by that step."""
+    d = closing_delta(hand_spec)
+    return d / d.abs().max().clamp(min=1e-6)
+
+
 class ScriptedGrasp:
     """The scripted policy for the unwrapped grasp task ``u`` right after its reset; each call
     returns the next normalised action."""
