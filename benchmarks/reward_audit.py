@@ -12,7 +12,7 @@ import argparse
 import time
 from pathlib import Path
 
-from unicross.audit import audit, behaviours, format_rows, physical_reference
+from unicross.audit import ASCENT_FRACTIONS, ascent, audit, behaviours, first_dip, format_rows, physical_reference
 from unicross.config import load_preset
 from unicross.registry import SKILLS
 
@@ -25,6 +25,7 @@ def main(argv=None) -> int:
     p.add_argument("--limit", type=int, default=2)
     p.add_argument("--seeds", type=int, default=3)
     p.add_argument("--in-hand-seeds", type=int, default=1, help="episodes per object for rotate/translate (400/64 steps)")
+    p.add_argument("--ascent-seeds", type=int, default=2, help="episodes per object on each ascent step")
     p.add_argument("--modes", default=None, help="comma list like grasp,rotate:x+ (default: all ten)")
     args = p.parse_args(argv)
     modes = MODES
@@ -35,8 +36,8 @@ def main(argv=None) -> int:
              "Reference behaviours per mode, ranked by their return as PPO sees it (each term discounted by "
              "gamma and multiplied by reward_scale; `configs/ppo.yaml` training env). `raw return` is the "
              "undiscounted, unscaled sum. Made by `python benchmarks/reward_audit.py "
-             f"--limit {args.limit} --seeds {args.seeds} --in-hand-seeds {args.in_hand_seeds}`.", ""]
-    verdict = []
+             f"--limit {args.limit} --seeds {args.seeds} --in-hand-seeds {args.in_hand_seeds} --ascent-seeds {args.ascent_seeds}`.", ""]
+    verdict, ascents = [], []
     for skill, axis in modes:
         seeds = args.seeds if skill in ("grasp", "relocate") else args.in_hand_seeds
         limit = args.limit if skill in ("grasp", "relocate") else 1
@@ -54,12 +55,28 @@ def main(argv=None) -> int:
             phys_cell = f"`{phys}` {1 + names.index(phys)} (zero {1 + names.index('zero')})" if phys in names else "--"
             verdict.append(f"| {title} | {label} | {rank} of {len(rows)} | {phys_cell} | {rows[0].behaviour} |")
             print(f"{title} ({label}): reference {ref} ranks {rank}/{len(rows)}", flush=True)
+            if phys:
+                t0 = time.time()
+                path = ascent(skill, axis, limit=args.limit, seeds=args.ascent_seeds, progress=False,
+                              ppo_overrides=load_preset(preset) if preset else None)
+                dip = first_dip(path)
+                lines += [f"### {title}: {label} coefficients, ascent to `{phys}` (its rate scaled from 0; "
+                          f"{'rises all the way' if dip is None else 'first falls at ' + dip}; "
+                          f"{time.time() - t0:.0f} s)", "", format_rows(path).replace("| rank |", "| step |"), ""]
+                ascents.append(f"| {title} | {label} | " + " | ".join(f"{r.total:.2f}" for r in path)
+                               + f" | {dip or 'none'} |")
     summary = ["## Summary", "",
                "The successful reference is the first behaviour of each mode (in-hand: the kinematic oracle). "
                "A physical reference (`unicross.audit.physical_reference`) does the mode through the physics "
                "alone; it must out-earn the zero action.", "",
                "| mode | coefficients | rank of the successful reference | physical reference rank (zero's) | first |",
                "|---|---|---|---|---|"] + verdict + [""]
+    if ascents:
+        summary += ["PPO starts at the zero action and climbs the return's gradient: the return must rise along the "
+                    "path to the physical reference, not only at its end (`unicross.audit.ascent`: the reference at "
+                    f"fractions {', '.join(f'{f:g}' for f in ASCENT_FRACTIONS)} of its rate).", "",
+                    "| mode | coefficients | " + " | ".join(f"x{f:g}" for f in ASCENT_FRACTIONS) + " | first dip |",
+                    "|---|---|" + "---|" * (len(ASCENT_FRACTIONS) + 1)] + ascents + [""]
     Path(args.out).parent.mkdir(parents=True, exist_ok=True)
     Path(args.out).write_text("\n".join(lines[:4] + summary + lines[4:]) + "\n")
     print(f"wrote {args.out}")

@@ -6,7 +6,7 @@ import pytest
 import torch
 
 import unicross  # noqa: F401
-from unicross.audit import audit
+from unicross.audit import ascent, ascent_behaviours, audit, first_dip
 from unicross.config import load_preset
 
 ENV = dict(obs_mode="state_dict", sim_backend="physx_cpu", render_backend="none", object_limit=1)
@@ -53,6 +53,20 @@ def test_translate_audit_pays_sliding_the_object_out_more_than_holding_still():
     paper = audit("translate", "z+", limit=1, seeds=1, progress=False, only=["open", "zero"],
                   ppo_overrides=load_preset("paper_reward"))
     assert [r.behaviour for r in paper] == ["zero", "open"]
+
+
+def test_translate_return_rises_on_the_way_to_opening_the_fingers():
+    """PPO starts at the zero action: opening at a quarter of the reference's rate (no success yet)
+    must already earn more than holding still. With the paper's r_motion weight it earned less
+    (the object tilts and the fingers bend before the slide pays): the valley that set
+    ``motion.translate``."""
+    ours = ascent("translate", "z+", fractions=(0.0, 0.25), limit=2, seeds=1, progress=False)
+    assert [r.behaviour for r in ours] == ["open@0", "open@0.25"] and first_dip(ours) is None
+    paper = ascent("translate", "z+", fractions=(0.0, 0.25), limit=2, seeds=1, progress=False,
+                   ppo_overrides=load_preset("paper_reward"))
+    assert first_dip(paper) == "open@0.25"
+    with pytest.raises(ValueError, match="no physical reference"):
+        ascent_behaviours("rotate", "x+")
 
 
 def test_random_rotate_returns_are_bounded_and_finite():

@@ -30,7 +30,8 @@ would pay a policy that does the skill. ``open`` and ``close`` are physical refe
 finger targets move steadily along the hand's opening (closing) direction, 0.02 rad per control
 step at most per joint, the wrist holding still. Opening the fingers slides a grasped object out
 along the fingers (translate z+: 8/8 successes palm up and from random wrist orientations on
-train objects), so translate z+ must pay it more than holding still (:func:`physical_reference`).
+train objects), so translate z+ must pay it more than holding still (:func:`physical_reference`),
+and more for every step on the way there (:func:`ascent`: the same sweep at a fraction of its rate).
 """
 from __future__ import annotations
 
@@ -143,10 +144,38 @@ def _oracle(u):
     return _zero(u)
 
 
+PHYSICAL_REFERENCES = {("translate", "z+"): ("open", -0.02)}  # (skill, axis) -> (behaviour, finger rate)
+ASCENT_FRACTIONS = (0.0, 0.125, 0.25, 0.375, 0.5, 0.75, 1.0)
+
+
 def physical_reference(skill: str, axis: Optional[str]) -> Optional[str]:
     """The behaviour that does the mode through the physics alone (no kinematic help), where one is
     known: it must out-earn holding still for PPO to have a reason to find it."""
-    return "open" if (skill, axis) == ("translate", "z+") else None
+    ref = PHYSICAL_REFERENCES.get((skill, axis))
+    return ref[0] if ref else None
+
+
+def ascent_behaviours(skill: str, axis: Optional[str], fractions=ASCENT_FRACTIONS) -> Dict[str, Callable]:
+    """The physical reference scaled from nothing (the zero action) to its full rate, as behaviours
+    named ``<reference>@<fraction>``. PPO starts near the zero action and follows the gradient of
+    the return: the reward gives it a path to the reference only when the return rises along the
+    way, not just at the end (:func:`ascent`)."""
+    if (skill, axis) not in PHYSICAL_REFERENCES:
+        raise ValueError(f"no physical reference for {skill} {axis}; known: {sorted(PHYSICAL_REFERENCES)}")
+    name, rate = PHYSICAL_REFERENCES[(skill, axis)]
+    return {f"{name}@{f:g}": _finger_sweep(rate * f) for f in fractions}
+
+
+def ascent(skill: str, axis: Optional[str], fractions=ASCENT_FRACTIONS, **audit_kw) -> List["AuditRow"]:
+    """:func:`audit` of :func:`ascent_behaviours`, in the order of the path (not ranked)."""
+    rows = audit(skill, axis, behaviour_set=ascent_behaviours(skill, axis, fractions), **audit_kw)
+    return sorted(rows, key=lambda r: float(r.behaviour.split("@")[1]))
+
+
+def first_dip(rows: List["AuditRow"]) -> Optional[str]:
+    """The first behaviour on an ascent path that earns less than the one before it (None: the
+    return rises all the way)."""
+    return next((b.behaviour for a, b in zip(rows, rows[1:]) if b.total < a.total), None)
 
 
 def behaviours(skill: str, seed: int = 0) -> Dict[str, Callable]:
@@ -181,10 +210,12 @@ class AuditRow:
 
 def audit(skill: str = "grasp", axis: Optional[str] = None, objects: Optional[str] = None, limit: int = 2,
           seeds: int = 3, hand: str = "allegro", ppo_overrides: Optional[dict] = None,
-          only: Optional[List[str]] = None, progress: bool = True) -> List[AuditRow]:
-    """Rolls every reference behaviour of ``skill`` out on the first ``limit`` objects per group
-    of ``objects`` (default: the skill's training set) for ``seeds`` seeds each, in the PPO
-    training env; returns the rows ranked by discounted scaled return (best first)."""
+          only: Optional[List[str]] = None, progress: bool = True,
+          behaviour_set: Optional[Dict[str, Callable]] = None) -> List[AuditRow]:
+    """Rolls every reference behaviour of ``skill`` (or those of ``behaviour_set``: name ->
+    factory(u) -> act()) out on the first ``limit`` objects per group of ``objects`` (default: the
+    skill's training set) for ``seeds`` seeds each, in the PPO training env; returns the rows
+    ranked by discounted scaled return (best first)."""
     import unicross  # noqa: F401  (registers the tasks)
     from tqdm import tqdm
     from unicross.objects import get_object_set
@@ -196,7 +227,7 @@ def audit(skill: str = "grasp", axis: Optional[str] = None, objects: Optional[st
     kw.pop("object_limit", None)
     kw.pop("reconfiguration_freq", None)
     objs = get_object_set(objects or skill_entry(skill).train_objects, limit=limit)
-    beh = behaviours(skill)
+    beh = behaviour_set if behaviour_set is not None else behaviours(skill)
     if only:
         bad = [b for b in only if b not in beh]
         if bad:

@@ -266,8 +266,18 @@ def _cmd_export(args) -> int:
 
 
 def _cmd_audit(args) -> int:
-    from unicross.audit import audit, behaviours, format_rows
+    from unicross.audit import ascent, audit, behaviours, first_dip, format_rows
     overrides = overrides_from(args)
+    if args.ascent:
+        rows = ascent(args.skill, args.axis, objects=args.objects, limit=args.limit, seeds=args.seeds,
+                      hand=args.hand, ppo_overrides=overrides or None)
+        print(format_rows(rows))
+        dip = first_dip(rows)
+        print("the return rises along the whole path" if dip is None else f"the return first falls at {dip}")
+        if args.out:
+            Path(args.out).parent.mkdir(parents=True, exist_ok=True)
+            Path(args.out).write_text(json.dumps([r.__dict__ for r in rows], indent=1))
+        return 0
     rows = audit(args.skill, args.axis, args.objects, args.limit, args.seeds, args.hand,
                  ppo_overrides=overrides or None, only=args.only.split(",") if args.only else None)
     table = format_rows(rows)
@@ -585,6 +595,8 @@ def main(argv=None) -> int:
     s.add_argument("--limit", type=positive, default=2, help="first N objects per (category, type) group")
     s.add_argument("--seeds", type=positive, default=3, help="episodes per object and behaviour")
     s.add_argument("--only", default=None, help="comma list of behaviours (default: all)")
+    s.add_argument("--ascent", action="store_true",
+                   help="instead: the mode's physical reference at fractions of its rate, in order (translate z+)")
     s.add_argument("--hand", default="allegro")
     s.add_argument("--preset", action="append", metavar="NAME", help="configs/presets/NAME.yaml (e.g. paper_reward)")
     s.add_argument("--set", action="append", metavar="SECTION.KEY=VALUE", help="override configs/ppo.yaml")
