@@ -4,7 +4,7 @@ import pytest
 import torch
 from torchrl.data import Bounded
 
-from unicross.rl.collector import LeanCollector, one_thread
+from unicross.rl.collector import LeanCollector, make_collector, one_thread
 from unicross.rl.models import make_models
 
 KW = dict(object_limit=1, reconfiguration_freq=1, config={"terminate_on_drop": False})  # episodes end at 64 steps
@@ -55,6 +55,28 @@ def test_workers_act_with_current_weights(num_envs):
             assert not torch.equal(data["hand"][0, 0], data["hand"][1, 0])
     finally:
         c.close()
+
+
+def test_correlated_noise_is_ar1_with_the_marginal_log_prob():
+    """collector.noise_correlation: the noise (action - loc) / scale is AR(1) in time with lag-one
+    correlation rho within an episode, white with rho 0, and the stored log-probability is the
+    per-step Gaussian's (the marginal), which the PPO loss recomputes."""
+    lag1 = {}
+    for rho in (0.0, 0.9):
+        c = LeanCollector("UniCross-Grasp-v1", KW, num_envs=1, horizon=64, seed=5, noise_correlation=rho)
+        try:
+            policy, _ = _models(c)
+            c.set_actor(policy.module[0].module)
+            data = c.collect()
+            _check_batch(policy, data)
+            eps = ((data["action"] - data["loc"]) / data["scale"])[0]  # [T, n_act], one episode
+            assert abs(float(eps.std()) - 1.0) < 0.15
+            lag1[rho] = float(torch.corrcoef(torch.stack([eps[1:].flatten(), eps[:-1].flatten()]))[0, 1])
+        finally:
+            c.close()
+    assert abs(lag1[0.0]) < 0.1 and abs(lag1[0.9] - 0.9) < 0.05, lag1
+    with pytest.raises(ValueError, match="noise_correlation"):
+        make_collector("UniCross-Grasp-v1", KW, 1, 8, 0, "physx_cpu", noise_correlation=1.0)
 
 
 def test_one_thread_holds_one_thread_and_restores_the_count():

@@ -77,7 +77,7 @@ RANGES = {
              "randomization.perturb_prob": (0, True), "disturbance.max_scale": (0, True),
              "drop_threshold": (0, False), "episode_length.*": (1, True)},
     "ppo": {"collector.total_frames": (1, True), "collector.frames_per_batch": (1, True),
-            "collector.horizon": (1, True), "env.num_envs": (1, True), "env.object_limit": (1, True),
+            "collector.horizon": (1, True), "collector.noise_correlation": (0, True), "env.num_envs": (1, True), "env.object_limit": (1, True),
             "env.reconfiguration_freq": (0, True), "gae.gamma": (0, True), "gae.lmbda": (0, True),
             "gae.reward_scale": (0, False), "optim.lr": (0, False), "optim.lr_min": (0, False),
             "optim.lr_max": (0, False), "optim.mini_epochs": (1, True), "optim.minibatch_size": (1, True),

@@ -115,7 +115,8 @@ class PPOTrainer(Runner):
         # envs of a resumed run start from new seeds (not a replay of the first iteration's starts)
         seed = cfg["seed"] + 1000 * int((self.ckpt or {}).get("iteration", 0))
         self.collector = make_collector(self.env_id, self.env_kwargs, num_envs, self.horizon, seed, ec["backend"],
-                                        cfg["collector"].get("ray_address"))
+                                        cfg["collector"].get("ray_address"),
+                                        noise_correlation=float(cfg["collector"].get("noise_correlation", 0.0)))
         if ec["backend"] == "physx_cpu":  # workers and the update take turns: the update gets every core
             torch.set_num_threads(os.cpu_count() or 1)
         self.device = self.collector.device

@@ -45,9 +45,9 @@ def connect(address: str) -> None:
 class _EnvActor:
     """One env and a copy of the actor network (a Ray actor; see the module docstring)."""
 
-    def __init__(self, env_id: str, env_kwargs: dict, seed: int, deterministic: bool):
+    def __init__(self, env_id: str, env_kwargs: dict, seed: int, deterministic: bool, noise_correlation: float = 0.0):
         torch.set_num_threads(1)
-        self.rollout = Rollout(env_id, env_kwargs, seed, deterministic)
+        self.rollout = Rollout(env_id, env_kwargs, seed, deterministic, noise_correlation)
 
     def sizes(self):
         return self.rollout.dims, self.rollout.n_act
@@ -73,14 +73,14 @@ class RayCollector:
     """:class:`unicross.rl.collector.LeanCollector`'s interface over ``num_envs`` Ray env actors."""
 
     def __init__(self, env_id: str, env_kwargs: dict, num_envs: int, horizon: int, seed: int = 0,
-                 address: str = "local", deterministic: bool = False):
+                 address: str = "local", deterministic: bool = False, noise_correlation: float = 0.0):
         ray = _require_ray()
         connect(address)
         self._ray = ray
         self.horizon, self.num_envs = horizon, num_envs
         kw = dict(env_kwargs, sim_backend="physx_cpu", num_envs=1)
         remote = ray.remote(num_cpus=1)(_EnvActor)
-        self._actors = [remote.remote(env_id, kw, seed + i, deterministic) for i in range(num_envs)]
+        self._actors = [remote.remote(env_id, kw, seed + i, deterministic, noise_correlation) for i in range(num_envs)]
         self.dims, self.n_act = ray.get(self._actors[0].sizes.remote())
         self.device = torch.device("cpu")
         self.actor: Optional[torch.nn.Module] = None
