@@ -150,7 +150,12 @@ def test_contact_distance_saturates_and_motion_is_capped():
     fast = RW.motion_reward(dict(m, speed_along_axis=torch.tensor([5.0, -5.0])), cm, mode)
     w = cm["w_p"][mode[0]]
     assert fast[0].item() == pytest.approx(float(w * 0.1))  # capped at v_max
-    assert fast[1].item() == pytest.approx(float(w * -5.0))  # not bounded below while held (paper)
+    assert fast[1].item() == pytest.approx(float(w * -0.1 * cfg["motion_floor"]))  # floored (ours)
+    paper = RW.RewardTerms(dict(cfg, motion_floor=math.inf), "cpu").coefficients("motion")
+    fast = RW.motion_reward(dict(m, speed_along_axis=torch.tensor([5.0, -5.0])), paper, mode)
+    assert fast[1].item() == pytest.approx(float(w * -5.0))  # the paper's: unbounded below while held
+    grasp = torch.tensor([F.MODES.index("grasp")] * 2)  # a zero cap and weight stay finite without a floor
+    assert torch.isfinite(RW.motion_reward(dict(m, speed_cap=torch.zeros(2)), paper, grasp)).all()
     lost = RW.motion_reward(dict(m, speed_along_axis=torch.tensor([5.0, -5.0]), held=torch.zeros(2, dtype=torch.bool)),
                             cm, mode)
     assert torch.equal(lost, torch.zeros(2))  # nothing after a drop: the paper's episode would have ended

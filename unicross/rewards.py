@@ -17,6 +17,7 @@ every env whatever its mode.
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Callable, Dict, Optional, Tuple
 
@@ -75,14 +76,18 @@ def contact_reward(m: dict, c: dict, mode: torch.Tensor) -> torch.Tensor:
     return per_link.mean(dim=-1)
 
 
-@reward_term("motion", lambda cfg, dev: dict(w_p=per_mode(cfg["motion"], dev)))
+@reward_term("motion", lambda cfg, dev: dict(w_p=per_mode(cfg["motion"], dev), floor=float(cfg["motion_floor"])))
 def motion_reward(m: dict, c: dict, mode: torch.Tensor) -> torch.Tensor:
-    """w_p · min(v_o^h · d^h, v_max) while the object is held (``held``: not dropped before this
-    step). The paper ends an episode at a drop, so it never pays motion after one; our training
-    episodes go on past drops (``terminate_on_drop: false``), and a lost object falling at 1-3 m/s
-    along the axis made this unbounded-below term -10 to -30 per step (translate), noise far
-    larger than anything a held object earns."""
-    return c["w_p"][mode] * torch.minimum(m["speed_along_axis"], m["speed_cap"]) * m["held"].float()
+    """w_p · clamp(v_o^h · d^h, -floor · v_max, v_max) while the object is held (``held``: not
+    dropped before this step; ``floor``: ``motion_floor``, inf in the paper). The paper ends an
+    episode at a drop, so it never pays motion after one; our training episodes go on past drops
+    (``terminate_on_drop: false``), and a lost object falling at 1-3 m/s along the axis made this
+    unbounded-below term -10 to -30 per step (translate), noise far larger than anything a held
+    object earns. The floor bounds the steps of a fall before the drop is detected."""
+    v = torch.minimum(m["speed_along_axis"], m["speed_cap"])
+    if math.isfinite(c["floor"]):  # (inf * a zero cap would be NaN)
+        v = torch.maximum(v, -c["floor"] * m["speed_cap"])
+    return c["w_p"][mode] * v * m["held"].float()
 
 
 @reward_term("success", lambda cfg, dev: dict(w=per_mode(cfg["success"], dev)))
