@@ -186,3 +186,25 @@ def test_shipped_relocate_expert_relocates_a_held_out_object():
     assert sum(t["success"] for t in trials) >= 1
     with pytest.raises(ValueError):
         E.resolve_policy("allegro/relocate", "mano")
+
+
+def test_init_reference_starts_the_mean_at_the_physical_reference(tmp_path):
+    """``model.init_reference``: the untrained policy's mean is the physical reference's constant
+    action (translate z+: opening the fingers) at that fraction of its rate; a mode without a
+    physical reference is refused before any simulation."""
+    from unicross.audit import PHYSICAL_REFERENCES, reference_action
+    from unicross.rl.ppo import PPOTrainer
+    from unicross.robots.hand import load_hand
+    over = dict(env=dict(num_envs=1, object_limit=1), collector=dict(total_frames=16, horizon=16),
+                model=dict(init_reference=0.5), logging=dict(eval_trials=0, final_eval_trials=0))
+    t = PPOTrainer(tmp_path / "tr", "translate", "z+", overrides=over, progress=False)
+    try:
+        want = reference_action("translate", "z+", load_hand("allegro"), 0.5)
+        torch.testing.assert_close(t.algo.actor.net.main[-1].bias.detach(), want)
+        rate = PHYSICAL_REFERENCES[("translate", "z+")][1]
+        assert float(want[6:].abs().max()) == pytest.approx(abs(rate) * 0.5 / 0.1)  # allegro fingers: 0.1 rad
+        assert float(want[:6].abs().max()) == 0.0
+    finally:
+        t.close()
+    with pytest.raises(ValueError, match="no physical reference"):
+        PPOTrainer(tmp_path / "rot", "rotate", "x+", overrides=over, progress=False)

@@ -101,18 +101,22 @@ def _naive_relocate(u):
     return lambda: scripted_relocate_policy(None, u)
 
 
-def _finger_sweep(rate: float):
-    """Finger targets move ``rate`` rad per control step along the closing direction (negative:
-    opening), scaled so the fastest joint moves ``|rate|``; the wrist residual is zero."""
-    def make(u):
-        from unicross.scripted_grasp import closing_direction
-        step = rate * closing_direction(u.hand_spec).to(u.device)
+def finger_sweep_action(hand_spec, rate: float) -> torch.Tensor:
+    """The constant normalised action [dof] that moves the finger targets ``rate`` rad per control
+    step along the closing direction (negative: opening), the fastest joint by ``|rate|``, with a
+    zero wrist residual."""
+    from unicross.scripted_grasp import closing_direction
+    scale = torch.as_tensor(hand_spec.action_scales(), dtype=torch.float32)
+    a = torch.zeros(hand_spec.dof)
+    a[6:] = (rate * closing_direction(hand_spec) / scale[6:]).clamp(-1.0, 1.0)
+    return a
 
-        def act():
-            a = torch.zeros(u.num_envs, u.hand_spec.dof, device=u.device)
-            a[:, 6:] = (step / u.action_scale[6:]).clamp(-1.0, 1.0)
-            return a
-        return act
+
+def _finger_sweep(rate: float):
+    """:func:`finger_sweep_action` at every step."""
+    def make(u):
+        a = finger_sweep_action(u.hand_spec, rate).to(u.device)
+        return lambda: a.expand(u.num_envs, -1).clone()
     return make
 
 
@@ -164,6 +168,14 @@ def ascent_behaviours(skill: str, axis: Optional[str], fractions=ASCENT_FRACTION
         raise ValueError(f"no physical reference for {skill} {axis}; known: {sorted(PHYSICAL_REFERENCES)}")
     name, rate = PHYSICAL_REFERENCES[(skill, axis)]
     return {f"{name}@{f:g}": _finger_sweep(rate * f) for f in fractions}
+
+
+def reference_action(skill: str, axis: Optional[str], hand_spec, fraction: float = 1.0) -> torch.Tensor:
+    """The constant normalised action [dof] of the physical reference of (``skill``, ``axis``) at
+    ``fraction`` of its rate: what ``model.init_reference`` starts a policy's mean at."""
+    if (skill, axis) not in PHYSICAL_REFERENCES:
+        raise ValueError(f"no physical reference for {skill} {axis}; known: {sorted(PHYSICAL_REFERENCES)}")
+    return finger_sweep_action(hand_spec, PHYSICAL_REFERENCES[(skill, axis)][1] * fraction)
 
 
 def ascent(skill: str, axis: Optional[str], fractions=ASCENT_FRACTIONS, **audit_kw) -> List["AuditRow"]:

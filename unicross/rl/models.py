@@ -130,6 +130,12 @@ class GaussianHead(nn.Module):
             last.weight.mul_(init_scale)
             last.bias.zero_()
 
+    @torch.no_grad()
+    def start_mean_at(self, action: torch.Tensor) -> None:
+        """Sets the last layer's bias so that the untrained mean is ``action`` [n_act] (plus the
+        near-zero state-dependent part of the scaled last layer)."""
+        self.net.main[-1].bias.copy_(action)
+
     def forward(self, hand, obj, goal):
         loc = self.net(hand, obj, goal)
         return loc, self.log_std.exp().expand_as(loc)

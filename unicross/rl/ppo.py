@@ -105,7 +105,11 @@ class PPOTrainer(Runner):
             skill, axis, hand = ck["skill"], ck["axis"], ck["hand"]
         skill, hand = skill or "grasp", hand or "allegro"
         from unicross.robots.hand import load_hand
-        load_hand(hand)  # validates
+        spec = load_hand(hand)  # validates
+        start_mean = None
+        if self.ckpt is None and cfg["model"].get("init_reference") is not None:  # refused before any simulation
+            from unicross.audit import reference_action
+            start_mean = reference_action(skill, axis, spec, float(cfg["model"]["init_reference"]))
         self.skill, self.axis, self.hand = skill, axis, hand
         self.env_id = R.skill(skill).env_id
         self.env_kwargs = env_kwargs_for(skill, axis, hand, cfg["env"])
@@ -122,6 +126,8 @@ class PPOTrainer(Runner):
         self.device = self.collector.device
         dims, self.n_act = self.collector.dims, self.collector.n_act
         self.algo = PPO(dims, self.n_act, cfg, self.collector.frames_per_batch, self.device)
+        if start_mean is not None:
+            self.algo.actor.start_mean_at(start_mean.to(self.device))
         self.iteration, self.frames = 0, 0
         self.dims = dims
         if self.ckpt is not None:
