@@ -31,6 +31,22 @@ def test_shards_together_give_the_unsharded_trials(grasp_file, tiny_objects):
     assert len(whole) == 4 and json.dumps(parts) == json.dumps(whole)
 
 
+def test_reference_policy_slides_the_object_out_and_is_refused_without_a_reference(grasp_file, tiny_objects, tmp_path):
+    """``--policy reference``: translate z+'s physical reference (opening the fingers) translates
+    the object where the zero action does not; a mode without a reference is refused before
+    any simulation."""
+    kw = dict(grasp_dataset=grasp_file, trials_per_object=2, seed=0, progress=False, axes=["z+"])
+    ref = E.summarize("translate", E.run_protocol("translate", E.resolve_policy("reference@0.75", "allegro")[0],
+                                                  tiny_objects, **kw))
+    zero = E.summarize("translate", E.run_protocol("translate", E.zero_policy, tiny_objects, **kw))
+    assert ref["trans_cm"] > zero["trans_cm"] + 2.0, (ref, zero)  # measured: +2.9 vs +0.02 cm
+    assert cli(["eval", "--policy", "reference", "--protocol", "translate", "--objects", "test", "--limit", "1",
+                "--out", str(tmp_path / "e.json")]) == 2  # z- has none
+    assert not (tmp_path / "e.json").exists()
+    with pytest.raises(ValueError, match="reference@FRACTION"):
+        E.resolve_policy("reference@x", "allegro")
+
+
 def test_scripted_relocation_baseline_table(grasp_file, tiny_objects):
     trials = E.run_protocol("relocate", E.scripted_relocate_policy, tiny_objects, trials_per_object=2,
                             grasp_dataset=grasp_file, progress=False)

@@ -309,6 +309,13 @@ def _cmd_eval(args) -> int:
             bad = [a for a in axes if a not in SKILLS[p].axes]
             if bad:
                 raise ValueError(f"--axis {args.axis}: {bad} are not axes of protocol {p!r}: {list(SKILLS[p].axes)}")
+    if E.reference_fraction(args.policy) is not None:
+        from unicross.audit import PHYSICAL_REFERENCES
+        missing = [f"{p} {a}" for p in protocols for a in ((axes or SKILLS[p].axes) if SKILLS[p].axes else (None,))
+                   if (p, a) not in PHYSICAL_REFERENCES]
+        if missing:
+            raise ValueError(f"--policy {args.policy}: no physical reference for {missing}; known: "
+                             f"{sorted(PHYSICAL_REFERENCES)} (e.g. --protocol translate --axis z+)")
     objs = get_object_set(args.objects, limit=args.limit)
     _, desc = E.resolve_policy(args.policy, args.hand, seed=args.seed)  # checks the checkpoint before simulating
     ablation = desc.get("ablation")
@@ -512,7 +519,8 @@ def main(argv=None) -> int:
     s.set_defaults(fn=_cmd_rollout)
     s = sub.add_parser("eval", help="run the paper's evaluation protocols; writes JSON (every trial) and a table")
     s.add_argument("--policy", required=True,
-                   help="checkpoint path, or zero | random | scripted-grasp | scripted-relocate")
+                   help="checkpoint path, or zero | random | scripted-grasp | scripted-relocate | reference[@FRACTION] "
+                        "(the physical reference: translate z+)")
     s.add_argument("--protocol", default="all", help="grasp, relocate, rotate, translate (comma list) or all")
     s.add_argument("--objects", default="test", help="object set: train | test | unseen (| -wrappable/-elongated | mesh:<file>)")
     s.add_argument("--limit", type=positive, default=None, help="first N objects per (category, type) group")

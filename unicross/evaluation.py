@@ -20,8 +20,9 @@ hand frame and in the world, drop flags) and scores it with :mod:`unicross.metri
 The protocol settings (trials per object, disturbance scale, PE/AE window) are in
 ``configs/eval.yaml``; steps, axes and object categories per protocol in :mod:`unicross.registry`.
 
-Policies: a checkpoint path, ``zero`` (no action), ``random`` or ``scripted-relocate`` (the
-paper's naive relocation baseline). Same seed and policy give identical results.
+Policies: a checkpoint path, ``zero`` (no action), ``random``, ``scripted-relocate`` (the
+paper's naive relocation baseline) or ``reference[@FRACTION]`` (the mode's physical reference,
+where one is known: translate z+ opens the fingers). Same seed and policy give identical results.
 """
 from __future__ import annotations
 
@@ -108,8 +109,41 @@ def make_scripted_grasp_policy() -> PolicyFn:
     return policy
 
 
+def make_reference_policy(fraction: float = 1.0) -> PolicyFn:
+    """The mode's physical reference (:data:`unicross.audit.PHYSICAL_REFERENCES`; translate z+:
+    opening the fingers) at ``fraction`` of its rate: a constant scripted action, the bar beyond
+    the zero action that an expert of that mode should beat."""
+    from unicross.audit import reference_action
+    from unicross.registry import mode_axis
+    cache = {}
+
+    def policy(obs, u):
+        key = (id(u), int(u.mode[0]))
+        if key not in cache:
+            m = F.MODES[key[1]]
+            cache[key] = reference_action(F.mode_skill(m), mode_axis(m), u.hand_spec, fraction).to(u.device)
+        return cache[key].expand(u.num_envs, -1).clone()
+    return policy
+
+
+def reference_fraction(spec: str) -> Optional[float]:
+    """``reference`` -> 1.0, ``reference@0.75`` -> 0.75, anything else -> None."""
+    if spec != "reference" and not spec.startswith("reference@"):
+        return None
+    try:
+        f = float(spec.split("@", 1)[1]) if "@" in spec else 1.0
+    except ValueError:
+        raise ValueError(f"policy {spec!r}: write reference or reference@FRACTION, e.g. reference@0.75") from None
+    if not f > 0:
+        raise ValueError(f"policy {spec!r}: the fraction of the reference's rate must be > 0")
+    return f
+
+
 def resolve_policy(spec: str, hand: str, seed: int = 0):
     """(policy_fn, description). Checkpoints are checked against the hand before any simulation."""
+    if reference_fraction(spec) is not None:
+        f = reference_fraction(spec)
+        return make_reference_policy(f), dict(kind="reference", fraction=f)
     if spec == "zero":
         return zero_policy, dict(kind="zero")
     if spec == "random":
