@@ -159,23 +159,26 @@ def physical_reference(skill: str, axis: Optional[str]) -> Optional[str]:
     return ref[0] if ref else None
 
 
+def _reference(skill: str, axis: Optional[str]):
+    """(behaviour name, finger rate) of the physical reference of (skill, axis); refuses a mode without one."""
+    if (skill, axis) not in PHYSICAL_REFERENCES:
+        raise ValueError(f"no physical reference for {skill} {axis}; known: {sorted(PHYSICAL_REFERENCES)}")
+    return PHYSICAL_REFERENCES[(skill, axis)]
+
+
 def ascent_behaviours(skill: str, axis: Optional[str], fractions=ASCENT_FRACTIONS) -> Dict[str, Callable]:
     """The physical reference scaled from nothing (the zero action) to its full rate, as behaviours
     named ``<reference>@<fraction>``. PPO starts near the zero action and follows the gradient of
     the return: the reward gives it a path to the reference only when the return rises along the
     way, not just at the end (:func:`ascent`)."""
-    if (skill, axis) not in PHYSICAL_REFERENCES:
-        raise ValueError(f"no physical reference for {skill} {axis}; known: {sorted(PHYSICAL_REFERENCES)}")
-    name, rate = PHYSICAL_REFERENCES[(skill, axis)]
+    name, rate = _reference(skill, axis)
     return {f"{name}@{f:g}": _finger_sweep(rate * f) for f in fractions}
 
 
 def reference_action(skill: str, axis: Optional[str], hand_spec, fraction: float = 1.0) -> torch.Tensor:
     """The constant normalised action [dof] of the physical reference of (``skill``, ``axis``) at
     ``fraction`` of its rate: what ``model.init_reference`` starts a policy's mean at."""
-    if (skill, axis) not in PHYSICAL_REFERENCES:
-        raise ValueError(f"no physical reference for {skill} {axis}; known: {sorted(PHYSICAL_REFERENCES)}")
-    return finger_sweep_action(hand_spec, PHYSICAL_REFERENCES[(skill, axis)][1] * fraction)
+    return finger_sweep_action(hand_spec, _reference(skill, axis)[1] * fraction)
 
 
 def ascent(skill: str, axis: Optional[str], fractions=ASCENT_FRACTIONS, **audit_kw) -> List["AuditRow"]:

@@ -271,21 +271,18 @@ def _cmd_audit(args) -> int:
     if args.ascent:
         rows = ascent(args.skill, args.axis, objects=args.objects, limit=args.limit, seeds=args.seeds,
                       hand=args.hand, ppo_overrides=overrides or None)
-        print(format_rows(rows))
+    else:
+        rows = audit(args.skill, args.axis, args.objects, args.limit, args.seeds, args.hand,
+                     ppo_overrides=overrides or None, only=args.only.split(",") if args.only else None)
+    print(format_rows(rows))
+    if args.ascent:
         dip = first_dip(rows)
         print("the return rises along the whole path" if dip is None else f"the return first falls at {dip}")
-        if args.out:
-            Path(args.out).parent.mkdir(parents=True, exist_ok=True)
-            Path(args.out).write_text(json.dumps([r.__dict__ for r in rows], indent=1))
-        return 0
-    rows = audit(args.skill, args.axis, args.objects, args.limit, args.seeds, args.hand,
-                 ppo_overrides=overrides or None, only=args.only.split(",") if args.only else None)
-    table = format_rows(rows)
-    print(table)
-    ranked = [r.behaviour for r in rows]
-    ref = next(iter(behaviours(args.skill)))  # each skill lists its successful reference first
-    if ref in ranked:
-        print(f"successful reference ({ref}) ranks {1 + ranked.index(ref)} of {len(rows)}")
+    else:
+        ranked = [r.behaviour for r in rows]
+        ref = next(iter(behaviours(args.skill)))  # each skill lists its successful reference first
+        if ref in ranked:
+            print(f"successful reference ({ref}) ranks {1 + ranked.index(ref)} of {len(rows)}")
     if args.out:
         Path(args.out).parent.mkdir(parents=True, exist_ok=True)
         Path(args.out).write_text(json.dumps([r.__dict__ for r in rows], indent=1))

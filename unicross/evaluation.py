@@ -141,8 +141,7 @@ def reference_fraction(spec: str) -> Optional[float]:
 
 def resolve_policy(spec: str, hand: str, seed: int = 0):
     """(policy_fn, description). Checkpoints are checked against the hand before any simulation."""
-    if reference_fraction(spec) is not None:
-        f = reference_fraction(spec)
+    if (f := reference_fraction(spec)) is not None:
         return make_reference_policy(f), dict(kind="reference", fraction=f)
     if spec == "zero":
         return zero_policy, dict(kind="zero")
