@@ -188,6 +188,34 @@ def test_shipped_relocate_expert_relocates_a_held_out_object():
         E.resolve_policy("allegro/relocate", "mano")
 
 
+def test_shipped_translate_expert_translates_a_held_out_object():
+    """The shipped translate z+ expert (allegro/translate_z+) slides a held elongated test object
+    out along the fingers under the paper's translate protocol, farther than the zero action."""
+    from unicross import evaluation as E
+    from unicross.objects import get_object_set
+    policy, desc = E.resolve_policy("allegro/translate_z+", "allegro")
+    assert (desc["skill"], desc.get("axis")) == ("translate", "z+")
+    obj = get_object_set("test-elongated", limit=1)[:1]
+    kw = dict(trials_per_object=2, seed=0, progress=False, axes=["z+"])
+    trials = E.run_protocol("translate", policy, obj, **kw)
+    zero = E.run_protocol("translate", E.zero_policy, obj, **kw)
+    assert sum(t["success"] for t in trials) >= 1 and not any(t["success"] for t in zero)
+
+
+def test_every_shipped_expert_loads_as_a_teacher_of_its_own_mode_only(tmp_path):
+    """Each shipped expert loads as DAgger's frozen teacher for its mode and is refused in the
+    folder of another mode."""
+    import pytest
+    from unicross.report import CHECKPOINTS, shipped
+    from unicross.rl.dagger import Teachers
+    experts = {m: CHECKPOINTS / "allegro" / f"{m}.pt" for m in shipped("allegro") if m != "student"}
+    assert {"grasp", "relocate", "translate_z+"} <= set(experts)
+    t = Teachers(experts, "cpu")
+    assert t.modes == list(experts) and not any(p.requires_grad for p in t.parameters())
+    with pytest.raises(ValueError, match="trained for mode"):
+        Teachers({"translate_z-": experts["translate_z+"]}, "cpu")
+
+
 def test_init_reference_starts_the_mean_at_the_physical_reference(tmp_path):
     """``model.init_reference``: the untrained policy's mean is the physical reference's constant
     action (translate z+: opening the fingers) at that fraction of its rate; a mode without a
