@@ -5,7 +5,7 @@ import pytest
 import torch
 
 from unicross import evaluation as E
-from unicross.cli import main as cli
+from unicross.cli import default_label, main as cli
 from unicross.objects import get_object_set
 
 
@@ -118,7 +118,9 @@ def test_cli_eval_and_report(tmp_path, grasp_file):
     assert cli(["eval", "--policy", "zero", "--protocol", "grasp", "--objects", "train-wrappable", "--limit", "1",
                 "--trials-per-object", "1", "--out", str(out)]) == 0
     r = json.loads(out.read_text())
-    assert r["summaries"]["grasp"]["n"] == 2 and len(r["trials"]["grasp"]) == 2
+    assert r["summaries"]["grasp"]["n"] == 2 and len(r["trials"]["grasp"]) == 2 and r["label"] == "zero"
+    assert [default_label(p) for p in ("reference@0.75", "allegro/grasp", "runs/a/checkpoint.pt")] == \
+        ["reference@0.75", "allegro/grasp", "checkpoint"]
     assert cli(["report", str(out), "--out", str(tmp_path / "t.md")]) == 0
     assert "Grasp SR" in (tmp_path / "t.md").read_text()
 

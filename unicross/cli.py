@@ -289,6 +289,12 @@ def _cmd_audit(args) -> int:
     return 0
 
 
+def default_label(policy: str) -> str:
+    """Table label of ``--policy``: a checkpoint file by its name, anything else ('zero',
+    'reference@0.75', 'allegro/grasp') as given."""
+    return Path(policy).stem if policy.endswith(".pt") else policy
+
+
 def _cmd_eval(args) -> int:
     from unicross import evaluation as E
     from unicross.objects import get_object_set
@@ -325,7 +331,7 @@ def _cmd_eval(args) -> int:
             raise ValueError(f"checkpoint {args.policy} was trained with ablation {trained or 'none'}; "
                              f"it is evaluated with the switches it was trained with (drop --ablation)")
         ablation = {f: True for f in args.ablation}
-    label = args.label or Path(args.policy).stem
+    label = args.label or default_label(args.policy)
     result = dict(label=label, policy=desc, objects=args.objects, limit=args.limit, hand=args.hand,
                   trials_per_object=args.trials_per_object, seed=args.seed, axes=axes, disturb=args.disturb,
                   original=args.original, randomize=args.randomize, ablation=ablation or {}, summaries={}, trials={})
