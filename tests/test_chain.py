@@ -105,3 +105,12 @@ def test_chain_state_round_trip_keeps_the_phase():
     assert u.phase.tolist() == [1] and u.mode.item() == F.MODES.index("relocate")
     assert torch.allclose(u.get_obs(), obs, atol=1e-5)
     env.close()
+
+
+def test_last_phase_by_mode_splits_a_sequence_kind_by_its_in_hand_mode():
+    from unicross.evaluation import chain_last_phase_by_mode
+    t = lambda m, ok: dict(sequence=["grasp", "relocate", m], phase_success=[True, True, ok])  # noqa: E731
+    s = chain_last_phase_by_mode([t("translate_z+", True), t("translate_z+", True), t("translate_z-", False),
+                                  t("translate_z+", False)])
+    assert list(s) == ["translate_z+", "translate_z-"]
+    assert (s["translate_z+"]["n"], s["translate_z+"]["successes"]) == (3, 2) and s["translate_z-"]["sr"] == 0.0

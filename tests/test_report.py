@@ -15,6 +15,7 @@ def test_report_paper_one_trial(tmp_path):
     for title in ("Experts, held-out test objects", "Student, held-out test objects", "Unseen objects",
                   "Disturbances", "Baselines", "Long horizon"):
         assert f"## {title}" in text
+    assert "In-hand phase by mode: " in text
     n_test = len(get_object_set("test", limit=1))
     ships = shipped("allegro")
     for mode in ("grasp", "relocate"):

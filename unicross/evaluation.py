@@ -444,6 +444,15 @@ def summarize_chain(trials: List[dict]) -> Dict[str, dict]:
     return out
 
 
+def chain_last_phase_by_mode(trials: List[dict]) -> Dict[str, dict]:
+    """Success of the last (in-hand) phase per mode over every trial of that mode, e.g. a
+    Gr.+Re.+Trans. table split into translate_z+ and translate_z-."""
+    by: Dict[str, List[bool]] = {}
+    for t in trials:
+        by.setdefault(t["sequence"][-1], []).append(bool(t["phase_success"][-1]))
+    return {m: M.success_summary(torch.tensor(v, dtype=torch.bool)) for m, v in sorted(by.items())}
+
+
 def chain_table(summary: Dict[str, dict]) -> str:
     lines = ["| Sequence | Grasp SR | Relocate SR | In-hand SR | Overall SR |", "|---|---|---|---|---|"]
     for kind, s in summary.items():
