@@ -202,7 +202,7 @@ def test_shipped_translate_expert_translates_a_held_out_object():
     assert sum(t["success"] for t in trials) >= 1 and not any(t["success"] for t in zero)
 
 
-def test_every_shipped_expert_loads_as_a_teacher_of_its_own_mode_only(tmp_path):
+def test_every_shipped_expert_loads_as_a_teacher_of_its_own_mode_only():
     """Each shipped expert loads as DAgger's frozen teacher for its mode and is refused in the
     folder of another mode."""
     import pytest

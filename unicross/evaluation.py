@@ -453,10 +453,14 @@ def chain_last_phase_by_mode(trials: List[dict]) -> Dict[str, dict]:
     return {m: M.success_summary(torch.tensor(v, dtype=torch.bool)) for m, v in sorted(by.items())}
 
 
+def sr_cell(s: dict) -> str:
+    """A success summary as 'SR [lo-hi] (n=N)' (the chain tables' cell)."""
+    return f"{s['sr']:.1f} [{s['ci95'][0]:.0f}-{s['ci95'][1]:.0f}] (n={s['n']})"
+
+
 def chain_table(summary: Dict[str, dict]) -> str:
     lines = ["| Sequence | Grasp SR | Relocate SR | In-hand SR | Overall SR |", "|---|---|---|---|---|"]
     for kind, s in summary.items():
-        cells = [f"{p['sr']:.1f} [{p['ci95'][0]:.0f}-{p['ci95'][1]:.0f}] (n={p['n']})" for p in s["per_phase"]]
-        lines.append(f"| {kind} | " + " | ".join(cells[:3]) + f" | {s['overall']['sr']:.1f} "
-                     f"[{s['overall']['ci95'][0]:.0f}-{s['overall']['ci95'][1]:.0f}] (n={s['n']}) |")
+        cells = [sr_cell(p) for p in s["per_phase"][:3]] + [sr_cell(s["overall"])]
+        lines.append(f"| {kind} | " + " | ".join(cells) + " |")
     return "\n".join(lines)

@@ -136,15 +136,15 @@ class PaperReport:
         return "\n".join(lines)
 
     def _long_horizon(self) -> List[str]:
-        from unicross.evaluation import chain_last_phase_by_mode, chain_table, run_chain, summarize_chain, resolve_policy
+        from unicross.evaluation import (chain_last_phase_by_mode, chain_table, run_chain, summarize_chain,
+                                         resolve_policy, sr_cell)
         policy, _ = resolve_policy(self.ckpts["student"], self.hand)
         objs = get_object_set("test", limit=self.limit)
         trials = run_chain(policy, objs, hand=self.hand, trials_per_object=self.trials, seed=self.seed, progress=False)
         missing = [m for m in F.MODES if m not in self.student_modes]
         note = ([f"The student was distilled for {', '.join(self.student_modes)} only (no expert for "
                  f"{', '.join(missing)}): phases of those modes are not expected to succeed.", ""] if missing else [])
-        by_mode = "; ".join(f"{m} {v['sr']:.1f} [{v['ci95'][0]:.0f}-{v['ci95'][1]:.0f}] (n={v['n']})"
-                            for m, v in chain_last_phase_by_mode(trials).items())
+        by_mode = "; ".join(f"{m} {sr_cell(v)}" for m, v in chain_last_phase_by_mode(trials).items())
         return note + [chain_table(summarize_chain(trials)), "", f"In-hand phase by mode: {by_mode}.", "",
                 "Paper: " + "; ".join(f"{k} {' / '.join(f'{x:g}' for x in v)}" for k, v in PAPER["long"].items()), ""]
 
