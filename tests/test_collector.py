@@ -4,7 +4,8 @@ import pytest
 import torch
 from torchrl.data import Bounded
 
-from unicross.rl.collector import LeanCollector, make_collector, one_thread
+from unicross.rl import collector as C
+from unicross.rl.collector import LeanCollector, make_collector, one_thread, update_threads, usable_cores
 from unicross.rl.models import make_models
 
 KW = dict(object_limit=1, reconfiguration_freq=1, config={"terminate_on_drop": False})  # episodes end at 64 steps
@@ -90,6 +91,36 @@ def test_one_thread_holds_one_thread_and_restores_the_count():
         assert torch.get_num_threads() == 2
     finally:
         torch.set_num_threads(before)
+
+
+def test_update_threads_share_the_cores_among_live_runs(tmp_path, monkeypatch):
+    import subprocess
+    import sys
+    monkeypatch.setattr(C, "RUNS_DIR", tmp_path / "runs")
+    assert C.concurrent_runs() == 1 and update_threads(None) == usable_cores()
+    dead = subprocess.Popen([sys.executable, "-c", "pass"])
+    dead.wait()
+    live = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(60)"])
+    try:
+        C.register_run()
+        for name in (str(dead.pid), str(live.pid), "not-a-pid"):
+            (C.RUNS_DIR / name).touch()
+        assert C.concurrent_runs() == 2  # this process and the live one
+        assert update_threads(None) == max(1, usable_cores() // 2)
+    finally:
+        live.kill()
+        live.wait()
+    assert C.concurrent_runs() == 1
+    assert update_threads(1) == 1
+    for bad in (0, -2, 1.5, "2", True):
+        with pytest.raises(ValueError, match="update_threads"):
+            update_threads(bad)
+
+
+def test_trainers_refuse_bad_update_threads_before_simulating(tmp_path):
+    from unicross.rl.ppo import PPOTrainer
+    with pytest.raises(ValueError, match="update_threads"):
+        PPOTrainer(tmp_path / "run", skill="grasp", overrides={"optim": {"update_threads": 0}}, progress=False)
 
 
 def test_worker_errors_are_raised_in_the_main_process():

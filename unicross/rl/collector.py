@@ -20,11 +20,14 @@ last one of an episode, before the reset), ``reward``, ``done``, ``terminated`` 
 """
 from __future__ import annotations
 
+import atexit
 import contextlib
 import math
 import os
 import signal
+import tempfile
 import traceback
+from pathlib import Path
 from typing import Optional
 
 import torch
@@ -169,6 +172,52 @@ def _worker(rank: int, env_id: str, env_kwargs: dict, seed: int, deterministic: 
     rollout.close()
 
 
+def usable_cores() -> int:
+    """Cores this process may run on (its CPU affinity where the OS reports it)."""
+    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+
+
+RUNS_DIR = Path(tempfile.gettempdir()) / "unicross-runs"
+
+
+def register_run() -> None:
+    """Marks this process as a training run on this machine (a file named by its pid under
+    :data:`RUNS_DIR`, removed at exit), so that runs started side by side share the cores in their
+    updates (:func:`update_threads`)."""
+    RUNS_DIR.mkdir(parents=True, exist_ok=True)
+    mark = RUNS_DIR / str(os.getpid())
+    mark.touch()
+    atexit.register(lambda: mark.unlink(missing_ok=True))
+
+
+def concurrent_runs() -> int:
+    """Training runs alive on this machine (:func:`register_run`), this one included; at least 1."""
+    alive = 0
+    for mark in RUNS_DIR.glob("*") if RUNS_DIR.is_dir() else []:
+        try:
+            os.kill(int(mark.name), 0)
+        except (ValueError, ProcessLookupError):
+            continue
+        except PermissionError:  # another user's live process
+            pass
+        alive += 1
+    return max(alive, 1)
+
+
+def update_threads(value) -> int:
+    """Torch threads for the main process's update (``optim.update_threads``): ``None`` -> the
+    usable cores divided among the training runs alive on this machine (at least 1), else the
+    positive integer given. Measured on 2 cores (grasp, 2 workers per run, frames/s per run): one
+    run 372 on 2 threads, 351 on 1; two runs at once 88 each on 2 threads (the update 13x slower:
+    OpenMP threads wait at every op's barrier for a thread descheduled by the other run's workers),
+    176 each on 1 (benchmarks/update_contention.py isolates the update)."""
+    if value is None:
+        return max(1, usable_cores() // concurrent_runs())
+    if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+        raise ValueError(f"optim.update_threads must be null or an integer >= 1, got {value!r}")
+    return value
+
+
 @contextlib.contextmanager
 def one_thread():
     """Torch on one intra-op thread inside the block. Stepping one env and its policy on a batch of
@@ -307,7 +356,7 @@ def resolve_num_envs(num_envs, backend: str, ray_address: Optional[str] = None) 
         if ray_address:
             import ray
             return max(1, int(ray.cluster_resources().get("CPU", 1)))
-        return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+        return usable_cores()
     if int(num_envs) < 1:
         raise ValueError(f"env.num_envs must be >= 1, got {num_envs}")
     return int(num_envs)
