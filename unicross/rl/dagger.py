@@ -28,7 +28,7 @@ from tqdm import tqdm
 
 from unicross import formulation as F
 from unicross import registry as R
-from unicross.rl.collector import make_collector, register_run, resolve_num_envs, update_threads
+from unicross.rl.collector import make_collector, resolve_num_envs
 from unicross.rl.models import OBS_KEYS, make_models
 from unicross.rl.policy_io import load_policy
 from unicross.rl.runner import CKPT_NAME, Runner, atomic_save
@@ -111,10 +111,7 @@ class DAggerTrainer(Runner):
         if ec.get("object_limit") is not None:
             kw["object_limit"] = ec["object_limit"]
         self.device = torch.device("cuda" if ec["backend"] == "physx_cuda" else "cpu")
-        update_threads(cfg["optim"].get("update_threads"))  # refused before any simulation
-        self._cpu_update = ec["backend"] == "physx_cpu"  # workers and the main process (labels, updates) take turns
-        if self._cpu_update:
-            register_run()
+        self.share_cores(ec["backend"])
         self.teachers = Teachers(paths, self.device)
         kw["hand"] = self.teachers.hand
         self.env_kwargs = kw
@@ -244,8 +241,7 @@ class DAggerTrainer(Runner):
         last = {}
         while self.epoch < target and self.stop_signal is None:
             t0 = time.perf_counter()
-            if self._cpu_update:  # the cores the workers leave idle, shared with other runs on this machine
-                torch.set_num_threads(update_threads(self.cfg["optim"].get("update_threads")))
+            self.take_update_threads()
             col = self.collect()
             upd = self.update()
             self.epoch += 1

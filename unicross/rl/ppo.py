@@ -25,7 +25,7 @@ from unicross import formulation as F
 from unicross import registry as R
 from unicross.rewards import term_names
 from unicross.rl.algorithm import PPO
-from unicross.rl.collector import make_collector, register_run, resolve_num_envs, update_threads
+from unicross.rl.collector import make_collector, resolve_num_envs
 from unicross.rl.models import OBS_KEYS  # noqa: F401  (re-exported for benchmarks)
 from unicross.rl.runner import CKPT_NAME, Runner, atomic_save, git_commit, open_run  # noqa: F401  (re-exported)
 
@@ -113,7 +113,7 @@ class PPOTrainer(Runner):
         self.env_id = R.skill(skill).env_id
         self.env_kwargs = env_kwargs_for(skill, axis, hand, cfg["env"])
         ec = cfg["env"]
-        update_threads(cfg["optim"].get("update_threads"))  # refused before any simulation
+        self.share_cores(ec["backend"])
         num_envs = resolve_num_envs(ec["num_envs"], ec["backend"], cfg["collector"].get("ray_address"))
         self.horizon = resolve_horizon(cfg["collector"], skill, num_envs)
         # envs of a resumed run start from new seeds (not a replay of the first iteration's starts)
@@ -121,9 +121,6 @@ class PPOTrainer(Runner):
         self.collector = make_collector(self.env_id, self.env_kwargs, num_envs, self.horizon, seed, ec["backend"],
                                         cfg["collector"].get("ray_address"),
                                         noise_correlation=float(cfg["collector"].get("noise_correlation", 0.0)))
-        self._cpu_update = ec["backend"] == "physx_cpu"  # workers and the update take turns: the update gets the cores
-        if self._cpu_update:
-            register_run()
         self.device = self.collector.device
         dims, self.n_act = self.collector.dims, self.collector.n_act
         self.algo = PPO(dims, self.n_act, cfg, self.collector.frames_per_batch, self.device)
@@ -271,8 +268,7 @@ class PPOTrainer(Runner):
             reward_raw = float(data["next", "reward"].mean())
             ep["nonfinite"] = int(data["next", "info", "nonfinite"].sum())
             t0 = time.perf_counter()
-            if self._cpu_update:  # the cores this run's workers leave idle, shared with other runs
-                torch.set_num_threads(update_threads(self.cfg["optim"].get("update_threads")))
+            self.take_update_threads()
             up = self.algo.update(data)
             t_update = time.perf_counter() - t0
             bad = sorted(k for k, v in up.items() if isinstance(v, float) and not math.isfinite(v))

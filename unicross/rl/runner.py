@@ -29,6 +29,7 @@ import numpy as np
 import torch
 
 from unicross.config import deep_merge, load_config, validate_ranges
+from unicross.rl.collector import register_run, update_threads
 
 CKPT_NAME = "checkpoint.pt"
 
@@ -164,6 +165,22 @@ class Runner:
         torch.manual_seed(seed)
         np.random.seed(seed)
         random.seed(seed)
+
+    # ------------------------------------------------------------------ cores
+    def share_cores(self, backend: str) -> None:
+        """Checks ``optim.update_threads`` (before any simulation) and, on the CPU backend, where the
+        env workers and the main process take turns, marks this run so that runs side by side share
+        the cores in their updates."""
+        update_threads(self.cfg["optim"].get("update_threads"))
+        self._cpu_update = backend == "physx_cpu"
+        if self._cpu_update:
+            register_run()
+
+    def take_update_threads(self) -> None:
+        """Before the main process's work of an iteration: torch threads = its share of the cores
+        (:func:`unicross.rl.collector.update_threads`)."""
+        if self._cpu_update:
+            torch.set_num_threads(update_threads(self.cfg["optim"].get("update_threads")))
 
     # ------------------------------------------------------------------ checkpoint
     def state(self) -> dict:
