@@ -31,8 +31,8 @@ from mani_skill.utils.structs.pose import Pose
 
 from unicross import formulation as F
 from unicross import registry as R
-from unicross.compiling import compile_enabled, maybe_compile
-from unicross.config import load_config
+from unicross.compiling import compile_enabled, compile_method
+from unicross.config import freeze, load_config
 from unicross.grasps import GraspSet, default_grasp_path
 from unicross.objects import resolve_objects
 from unicross.observations import obs_layout, observe, resolve as resolve_observation, unflatten
@@ -106,9 +106,8 @@ class UniCrossEnv(TaskScene, EpisodeStarts, StepMath, TaskStateIO, BaseEnv):
                              f"targets, see formulation.map_action), not {kwargs['control_mode']!r}: pass "
                              f"control_mode='pd_joint_pos' (ManiSkill's PPO baseline: --control_mode pd_joint_pos)")
         self._compiled = compile_enabled()  # UNICROSS_COMPILE (unicross/compiling.py), read once per env
-        self._step_math = maybe_compile(self._step_math_eager, cpu=not gpu) if self._compiled else self._step_math_eager
-        self._command_math = (maybe_compile(self._command_math_eager, cpu=not gpu) if self._compiled
-                              else self._command_math_eager)
+        self._step_math = compile_method(self, self._step_math_eager, cpu=not gpu)
+        self._command_math = compile_method(self, self._command_math_eager, cpu=not gpu)
         self.hand_spec: HandSpec = load_hand(hand)
         if hand_overrides:
             import dataclasses
@@ -116,7 +115,8 @@ class UniCrossEnv(TaskScene, EpisodeStarts, StepMath, TaskStateIO, BaseEnv):
         self.cfg = load_config("task", config)
         if randomize is not None:
             self.cfg["randomization"]["enabled"] = bool(randomize)
-        self.reward_cfg = load_config("reward", reward_config)
+        self.cfg = freeze(self.cfg)  # fixed from here: the compiled step math reads it once
+        self.reward_cfg = freeze(load_config("reward", reward_config))
         self._obs_terms = resolve_observation(self.cfg["observation"])
         modes = tuple(modes or self.DEFAULT_MODES)
         bad = [m for m in modes if m not in F.MODES]

@@ -4,7 +4,7 @@
 -> joint command map, the measurements (link-to-surface vectors, finger torques), relational poses,
 accumulated motion, drop, success, the reward terms, the next targets and the observation parts.
 It is pure tensor math on the task state (no reads, no random draws), compiled to one graph per
-process when ``UNICROSS_COMPILE`` is on (``unicross/compiling.py``).
+task when ``UNICROSS_COMPILE`` is on (``unicross/compiling.py``).
 """
 from __future__ import annotations
 
@@ -23,6 +23,14 @@ from unicross.geometry import (
 
 class StepMath:
     """Per-step math of the UniCross task (a mixin of ``UniCrossEnv``)."""
+
+    def _graph_key(self):
+        """The Python values the step math reads that may change after construction: the skill
+        every env shares (``static_skill``, per chain phase), the closest-point formulas and whether
+        the scene has meshes (scene rebuilds). They select the compiled graph
+        (``unicross.compiling.GraphMethod``); every other Python value it reads (configuration,
+        reward terms, hand) is fixed when the task is made."""
+        return self.static_skill, self._closest_kinds, self.obj_tris is None
 
     def _command_math_eager(self, a: torch.Tensor, elapsed_steps: torch.Tensor, perturb_normal=None,
                             perturb_uniform=None):

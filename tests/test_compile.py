@@ -3,7 +3,7 @@ import pytest
 import torch
 
 from conftest import make
-from unicross.compiling import CPU_OPTIONS, compile_enabled, maybe_compile
+from unicross.compiling import GraphMethod, compile_enabled, maybe_compile
 
 IDS = [("UniCross-Grasp-v1", {}), ("UniCross-Relocate-v1", {}), ("UniCross-Rotate-v1", {"axis": "x-"}),
        ("UniCross-Translate-v1", {"direction": "z+"}), ("UniCross-MultiSkill-v1", {})]
@@ -22,8 +22,9 @@ def test_switch(monkeypatch):
 
 
 def _compare(task, kw, grasp_file):
-    """Step a few times with random actions, then run one step's math eagerly and compiled from the
-    same reads and the same task state: every info value and every state tensor it writes agree
+    """Step a few times with random actions, then run one step's math eagerly and compiled
+    (:class:`GraphMethod`, what ``UNICROSS_COMPILE=1`` runs on the CPU) from the same reads and the
+    same task state: every info value and every state tensor it writes agree
     (the compiled run also evaluates every primitive's closest-point formula, as it does when
     UNICROSS_COMPILE is on, while the eager run evaluates only the object's own)."""
     env = make(task, grasp_file, **kw)
@@ -40,8 +41,7 @@ def _compare(task, kw, grasp_file):
     (eager_targets, eager_forces), eager_command, eager_perturb = u._command_math_eager(a, u.elapsed_steps, *draws), \
         u.command, u.perturb
     vars(u).update(saved)
-    targets, forces = torch.compile(u._command_math_eager, fullgraph=True, dynamic=False,
-                                    options=CPU_OPTIONS)(a, u.elapsed_steps, *draws)
+    targets, forces = GraphMethod(u, type(u)._command_math_eager)(a, u.elapsed_steps, *draws)
     torch.testing.assert_close(targets, eager_targets, atol=1e-5, rtol=1e-5)
     torch.testing.assert_close(forces, eager_forces, atol=1e-5, rtol=1e-5)
     assert float(forces.abs().max()) > 0
@@ -57,14 +57,15 @@ def _compare(task, kw, grasp_file):
     eager_state = dict(vars(u))
     vars(u).update(saved)
     u._closest_kinds = frozenset(range(4))  # as when compiling: every primitive's formula, selected per env
-    compiled = torch.compile(u._step_math_eager, fullgraph=True, dynamic=False, options=CPU_OPTIONS)
-    info, out = compiled(*reads, u.elapsed_steps, noise)
+    info, out = GraphMethod(u, type(u)._step_math_eager)(*reads, u.elapsed_steps, noise)
     assert info.keys() == eager_info.keys()
     for name, got, want in zip(("obs", "reward", "terminated", "truncated"), out, eager_out):
         torch.testing.assert_close(got, want, atol=1e-5, rtol=1e-5, msg=lambda m: f"{task} {name}: {m}")
     for k, v in eager_info.items():
         torch.testing.assert_close(info[k], v, atol=1e-5, rtol=1e-5, msg=lambda m: f"{task} info[{k}]: {m}")
     state = dict(vars(u))
+    assert {k for k, v in eager_state.items() if v is not saved.get(k)} == \
+        {k for k, v in state.items() if v is not saved.get(k)} - {"_closest_kinds"}  # the same attributes written
     for k, v in eager_state.items():
         got = state[k]
         if hasattr(v, "data") and not torch.is_tensor(v):  # Relational
@@ -103,5 +104,159 @@ def test_falls_back_to_eager_without_a_compiler(monkeypatch, tmp_path, capsys):
     g = maybe_compile(f)
     x = torch.arange(4.0)
     assert torch.equal(g(x), f(x)) and torch.equal(g(x), f(x))
-    assert "torch.compile failed" in capsys.readouterr().err
+    assert "compiling the step math failed" in capsys.readouterr().err
     torch._dynamo.reset()
+
+
+class _Toy:
+    """A task-like owner: tensor state, a Relational, a tuple of tensors, a Python setting and a
+    ``_graph_key``."""
+
+    def __init__(self, n=2):
+        from unicross.formulation import Relational
+        self.x = torch.arange(float(n))
+        self.rel = Relational(torch.ones(n, 21))
+        self.gains = (torch.tensor(2.0), torch.tensor(0.5))
+        self.scale = 3.0        # fixed after construction: baked into the graph
+        self.variant = "add"    # may change: named by _graph_key
+        self.unused = torch.zeros(5)
+        self.math = GraphMethod(self, _Toy.step)
+
+    def _graph_key(self):
+        return self.variant
+
+    def step(self, a, extra=None):
+        from unicross.formulation import Relational
+        y = self.x * self.gains[0] + a if self.variant == "add" else self.x * a
+        if extra is not None:
+            y = y + extra
+        self.x = y * self.scale
+        self.rel = Relational(self.rel.data + y.sum())
+        self.new = y.clone()  # an attribute the method creates
+        return {"y": y, "n": self.x.shape[0]}, (y.sum(), None)
+
+
+def _eager_twin(toy):
+    twin = _Toy.__new__(_Toy)
+    vars(twin).update({k: v for k, v in vars(toy).items() if k != "math"})
+    return twin
+
+
+def test_graph_method_matches_eager_and_writes_state():
+    toy = _Toy()
+    twin = _eager_twin(toy)
+    for i in range(3):
+        a = torch.full((2,), float(i))
+        got = toy.math(a)
+        want = _Toy.step(twin, a)
+        assert got[0]["n"] == want[0]["n"] == 2 and got[1][1] is None
+        torch.testing.assert_close(got[0]["y"], want[0]["y"])
+        torch.testing.assert_close(got[1][0], want[1][0])
+        for k in ("x", "new"):
+            torch.testing.assert_close(getattr(toy, k), getattr(twin, k))
+        torch.testing.assert_close(toy.rel.data, twin.rel.data)
+        assert type(toy.rel).__name__ == "Relational"
+    g = toy.math._graphs[("add", (False,))][0]
+    assert "unused" not in [n for n, _ in g.inputs] and "x" in [n for n, _ in g.inputs]
+    assert toy.math._count == 1  # one trace for three calls
+
+
+def test_graph_method_specialises_on_shapes_keys_and_missing_arguments():
+    toy = _Toy()
+    twin = _eager_twin(toy)
+
+    def both(*args):
+        got, want = toy.math(*args), _Toy.step(twin, *args)
+        torch.testing.assert_close(got[0]["y"], want[0]["y"])
+        torch.testing.assert_close(toy.x, twin.x)
+
+    both(torch.ones(2))
+    both(torch.ones(2), torch.ones(2))           # an argument given where it was None
+    assert toy.math._count == 2
+    toy.variant = twin.variant = "mul"           # a Python value named by _graph_key
+    both(torch.ones(2))
+    assert toy.math._count == 3
+    for t in (toy, twin):                        # new shapes: a new specialisation, not a wrong result
+        t.x, t.new = torch.arange(4.0), torch.zeros(4)
+        t.rel = type(t.rel)(torch.ones(4, 21))
+    both(torch.ones(4))
+    assert toy.math._count == 4
+    toy.x, twin.x = toy.x.double(), twin.x.double()  # a new dtype too
+    both(torch.ones(4, dtype=torch.float64))
+    assert toy.math._count == 5
+    toy.x = twin.x = torch.arange(8.0).view(4, 2)[:, 0]  # a strided view
+    both(torch.ones(4))
+    assert toy.math._count == 6
+    toy.x = twin.x = toy.x.contiguous()
+    a = toy.x                                    # an argument that is also state: no new trace
+    both(a.clone())
+    count = toy.math._count
+    both(toy.x)
+    assert toy.math._count == count
+
+
+def test_graph_method_refuses_writes_into_inputs_and_non_tensor_state():
+    class InPlace(_Toy):
+        def step(self, a, extra=None):
+            self.x[0] = a[0]
+            return self.x.sum()
+
+    class Flag(_Toy):
+        def step(self, a, extra=None):
+            self.flag = True
+            return self.x + a
+
+    with pytest.raises(TypeError, match="writes into x in place"):
+        t = InPlace()
+        GraphMethod(t, InPlace.step)(torch.ones(2))
+    with pytest.raises(TypeError, match="non-tensor attributes"):
+        t = Flag()
+        GraphMethod(t, Flag.step)(torch.ones(2))
+
+
+def test_graph_method_falls_back_to_eager_without_a_compiler(monkeypatch, tmp_path, capsys):
+    import torch._inductor.config as inductor_config
+    monkeypatch.setenv("TORCHINDUCTOR_CACHE_DIR", str(tmp_path))
+    monkeypatch.setattr(inductor_config.cpp, "cxx", (None, "/bin/false"))
+    toy = _Toy()
+    twin = _eager_twin(toy)
+    for _ in range(2):
+        torch.testing.assert_close(toy.math(torch.ones(2))[0]["y"], _Toy.step(twin, torch.ones(2))[0]["y"])
+    assert "failed" in capsys.readouterr().err and toy.math._eager
+
+
+@pytest.mark.slow
+def test_graph_method_follows_the_chain_like_torch_compile(monkeypatch):
+    """The chain changes a Python value the step math reads (``static_skill``) at its phase switches.
+    The compiled env follows it (``_graph_key``): step by step it gives what ``torch.compile`` gives
+    (whose guards re-check every Python value at every call). Eager is no reference here: contact
+    amplifies the ~1e-7 compiled-vs-eager differences to 1e-1 within a few steps of the grasp."""
+    import unicross.tasks.base as base
+    from unicross.scripted_grasp import ScriptedGrasp
+    monkeypatch.setenv("UNICROSS_COMPILE", "1")
+    runs = {}
+    for name in ("torch.compile", "GraphMethod"):
+        if name == "torch.compile":
+            monkeypatch.setattr(base, "compile_method", lambda owner, fn, cpu=True: maybe_compile(fn, cpu=cpu))
+        else:
+            monkeypatch.undo()
+            monkeypatch.setenv("UNICROSS_COMPILE", "1")
+        env = make("UniCross-Chain-v1", objects="test-wrappable", sequence="grasp,relocate,rotate:y-",
+                   phase_steps=dict(grasp=60, relocate=10, rotate=10), randomize=False)
+        u = env.unwrapped
+        assert isinstance(u._step_math, GraphMethod) == (name == "GraphMethod")
+        env.reset(seed=1)
+        policy = ScriptedGrasp(u)
+        rows = []
+        for t in range(80):
+            obs, reward, term, _, info = env.step(policy() if t < 55 else torch.zeros(1, 22))
+            rows.append((obs, reward, u.mode.item(), u.static_skill))
+            if term.any():
+                break
+        runs[name] = rows
+        env.close()
+    assert [r[2:] for r in runs["torch.compile"]] == [r[2:] for r in runs["GraphMethod"]]
+    assert {r[3] for r in runs["GraphMethod"]} == {"grasp", "relocate", "rotate"}
+    for (o0, r0, *_), (o1, r1, *_) in zip(runs["torch.compile"], runs["GraphMethod"]):
+        torch.testing.assert_close(o1, o0, atol=1e-6, rtol=1e-6)
+        torch.testing.assert_close(r1, r0, atol=1e-6, rtol=1e-6)

@@ -170,3 +170,19 @@ def test_progress_term_telescopes_to_the_error_reduction():
     total = sum(RW.progress_reward(dict(goal_err_prev=errs[t - 1], goal_err=errs[t]), c, mode) for t in range(1, 20))
     expect = c["w_pos"][mode] * (errs[0, :, 0] - errs[-1, :, 0]) + c["w_rot"][mode] * (errs[0, :, 1] - errs[-1, :, 1])
     assert torch.allclose(total, expect, atol=1e-6)
+
+
+def test_frozen_config_refuses_writes_and_copies_are_plain():
+    import copy
+    import pickle
+    from unicross.config import FrozenConfig, freeze
+    cfg = freeze({"a": {"b": 1}, "c": [1, 2]})
+    assert isinstance(cfg["a"], FrozenConfig) and cfg["a"]["b"] == 1 and dict(cfg)["c"] == [1, 2]
+    for write in (lambda: cfg.__setitem__("a", 2), lambda: cfg["a"].__setitem__("b", 2), lambda: cfg.update(a=1),
+                  lambda: cfg.pop("a"), lambda: cfg.setdefault("z", 1), lambda: cfg.clear(), lambda: cfg["a"].popitem()):
+        with pytest.raises(TypeError, match="fixed once the task is made"):
+            write()
+    for c in (copy.deepcopy(cfg), pickle.loads(pickle.dumps(cfg))):
+        assert type(c) is dict and type(c["a"]) is dict and c == {"a": {"b": 1}, "c": [1, 2]}
+        c["a"]["b"] = 5
+    assert cfg["a"]["b"] == 1 and type(copy.copy(cfg)) is dict

@@ -1,4 +1,4 @@
-"""``torch.compile`` for the per-step task math, behind one switch.
+"""The per-step task math compiled, behind one switch.
 
 ``UNICROSS_COMPILE=1`` (the default) compiles the tensor math of each step (``UniCrossEnv.
 _command_math_eager``: action -> joint targets; ``_step_math_eager``: everything ``evaluate()``
@@ -8,10 +8,12 @@ since a cold compile costs about a minute per process (Inductor's on-disk cache,
 ``/tmp/torchinductor_$USER`` or ``$TORCHINDUCTOR_CACHE_DIR``, brings later processes to seconds).
 Compiled and eager agree to 1e-5 after a step (tests/test_compile.py).
 
-On the CPU the graph is called through Inductor's C++ wrapper and without its size asserts
-(Dynamo's guards already check every input's shape before the graph runs): per call that saves
-~100 us of Python around ~100 us of kernels (rotate: step math 339 -> 241 us, command math 120 ->
-99 us, measured in one process, ``benchmarks/env_throughput.py``), for ~6 s more of cold compile.
+On the CPU (:class:`GraphMethod`) the method is traced once per task as a pure function of its
+arguments and the task's tensor state and compiled by Inductor without Dynamo: Dynamo re-checked
+~700 guards and replayed the method's attribute writes in Python at every call, ~250 us per call
+around ~140 us of kernels (rotate, step math). The graph runs through Inductor's C++ wrapper
+without its size asserts; one C++ check of the inputs' shapes, strides and dtypes guards it.
+On the GPU the methods go through ``torch.compile`` (:func:`maybe_compile`).
 """
 from __future__ import annotations
 
@@ -19,9 +21,11 @@ import functools
 import os
 import sys
 import time
-from typing import Callable
+import weakref
+from typing import Callable, List
 
 import torch
+import torch.utils._pytree as pytree
 
 RECOMPILE_LIMIT = 64
 # Inductor options of the CPU graphs (see the module docstring); GPU graphs keep the defaults
@@ -32,6 +36,22 @@ _ANNOUNCED = False
 def compile_enabled() -> bool:
     """The ``UNICROSS_COMPILE`` switch: on unless set to 0/false/off/no."""
     return os.environ.get("UNICROSS_COMPILE", "1").strip().lower() not in ("0", "false", "off", "no")
+
+
+def _announce_start() -> bool:
+    global _ANNOUNCED
+    if _ANNOUNCED:
+        return False
+    _ANNOUNCED = True
+    print(f"[unicross] compiling the step math (pid {os.getpid()}; about a minute the first time, seconds from "
+          "the cache; UNICROSS_COMPILE=0 runs it eagerly)", file=sys.stderr, flush=True)
+    return True
+
+
+def _fall_back(e: Exception) -> None:
+    print(f"[unicross] compiling the step math failed ({str(e).strip().splitlines()[0][:200]}); running it "
+          "eagerly (install a C++ compiler, e.g. g++, or set UNICROSS_COMPILE=0 to skip the attempt)",
+          file=sys.stderr, flush=True)
 
 
 def maybe_compile(fn: Callable, cpu: bool = True) -> Callable:
@@ -54,13 +74,7 @@ def maybe_compile(fn: Callable, cpu: bool = True) -> Callable:
 
     @functools.wraps(fn)
     def call(*args, **kwargs):
-        global _ANNOUNCED
-        announce = not _ANNOUNCED and impl[0] is compiled
-        if announce:
-            _ANNOUNCED = True
-            print(f"[unicross] compiling the step math with torch.compile (pid {os.getpid()}; about a minute "
-                  "the first time, seconds from the cache; UNICROSS_COMPILE=0 runs it eagerly)",
-                  file=sys.stderr, flush=True)
+        announce = impl[0] is compiled and _announce_start()
         t = time.perf_counter()
         try:
             out = impl[0](*args, **kwargs)
@@ -68,9 +82,7 @@ def maybe_compile(fn: Callable, cpu: bool = True) -> Callable:
             if impl[0] is not compiled:
                 raise
             impl[0] = fn
-            print(f"[unicross] torch.compile failed ({str(e).strip().splitlines()[0][:200]}); running the step "
-                  "math eagerly (install a C++ compiler, e.g. g++, or set UNICROSS_COMPILE=0 to skip the attempt)",
-                  file=sys.stderr, flush=True)
+            _fall_back(e)
             return fn(*args, **kwargs)
         if announce:
             print(f"[unicross] step math compiled in {time.perf_counter() - t:.1f} s (pid {os.getpid()})",
@@ -78,3 +90,300 @@ def maybe_compile(fn: Callable, cpu: bool = True) -> Callable:
         return out
 
     return call
+
+
+def _is_state(v) -> bool:
+    """A task attribute the compiled graph takes as input and may write: a tensor, or a registered
+    pytree (tuples, lists, dicts, ``formulation.Relational``) of tensors only."""
+    if torch.is_tensor(v):
+        return True
+    if isinstance(v, (str, bytes)) or pytree.tree_is_leaf(v):
+        return False
+    leaves = pytree.tree_leaves(v)
+    return bool(leaves) and all(torch.is_tensor(x) for x in leaves)
+
+
+class _InputGuard:
+    """Checks that a call's inputs have the shapes, strides, dtypes and devices the graph was traced
+    with (~10 us for the step math's ~40 inputs). Inputs may alias one another (a read that is also
+    task state; the graph never writes into its inputs, so that is harmless): each aliasing pattern
+    met gets Dynamo's C++ tensor check of its distinct tensors after an identity check of the repeats
+    (the C++ check refuses repeated tensors); the same check in Python serves where it is missing."""
+
+    def __init__(self, tensors: List[torch.Tensor]):
+        self.sig = [(t.shape, t.stride(), t.dtype, t.device) for t in tensors]
+        self.fast = []  # [(repeats, distinct positions, C++ check)], one per aliasing pattern met
+        self._add(tensors)
+
+    def _add(self, ts) -> None:
+        if len(self.fast) >= 4:
+            return
+        first, repeats = {}, []
+        for i, t in enumerate(ts):
+            if id(t) in first:
+                repeats.append((i, first[id(t)]))
+            else:
+                first[id(t)] = i
+        unique = sorted(first.values())
+        try:
+            from torch._C._dynamo.guards import TensorGuards
+            check = TensorGuards(*[ts[i] for i in unique], dynamic_dims_sizes=[list(ts[i].shape) for i in unique],
+                                 dynamic_dims_strides=[list(ts[i].stride()) for i in unique]).check
+        except Exception:  # pragma: no cover - a torch without Dynamo's C++ guards
+            return
+        self.fast.append((repeats, unique if repeats else None, check))
+
+    def slow(self, ts) -> bool:
+        return len(ts) == len(self.sig) and all(
+            (t.shape, t.stride(), t.dtype, t.device) == s for t, s in zip(ts, self.sig))
+
+    def __call__(self, ts: list) -> bool:
+        if len(ts) == len(self.sig):
+            for repeats, unique, check in self.fast:
+                if unique is None:
+                    if check(*ts):
+                        return True
+                elif all(ts[i] is ts[j] for i, j in repeats) and check(*[ts[i] for i in unique]):
+                    return True
+        if self.slow(ts):
+            self._add(ts)  # a new aliasing pattern of the same tensors
+            return True
+        return False
+
+
+def _unflattener(spec) -> Callable[[list], object]:
+    """``leaves -> pytree`` for ``spec`` as one generated expression (~10x faster than
+    ``pytree.tree_unflatten`` for the step math's outputs); other node types fall back to it."""
+    names = {"Relational": None}
+    counter = [0]
+
+    def expr(sp) -> str:
+        if sp.is_leaf():
+            counter[0] += 1
+            return f"L[{counter[0] - 1}]"
+        kids = [expr(c) for c in sp.children()]
+        if sp.type is dict:
+            return "{" + ", ".join(f"{k!r}: {v}" for k, v in zip(sp.context, kids)) + "}"
+        if sp.type is tuple:
+            return "(" + "".join(f"{v}, " for v in kids) + ")"
+        if sp.type is list:
+            return "[" + ", ".join(kids) + "]"
+        if sp.type.__name__ == "Relational" and len(kids) == 1:
+            names["Relational"] = sp.type
+            return f"Relational({kids[0]})"
+        raise NotImplementedError(sp.type)
+
+    try:
+        code = expr(spec)
+    except NotImplementedError:
+        return lambda leaves: pytree.tree_unflatten(leaves, spec)
+    return eval(f"lambda L: {code}", names)  # noqa: S307 - generated from the spec's own types and keys
+
+
+def _refuse_input_writes(gm, name: str, arg_names: List[str]) -> None:
+    """The traced graph must not write into its inputs (the task's tensors are read, and what the
+    method assigns comes back as outputs): raises naming the input, which an in-place write such
+    as ``self.x[:, 0] = v`` causes (write ``self.x = torch.cat(...)`` or a ``where`` instead)."""
+    placeholders = {n: i for i, n in enumerate(n for n in gm.graph.nodes if n.op == "placeholder")}
+    for node in gm.graph.nodes:
+        if node.op != "call_function" or not getattr(node.target, "_schema", None) or not node.target._schema.is_mutable:
+            continue
+        base = node.args[0]
+        while getattr(base, "op", None) == "call_function" and base.target._schema.returns and \
+                base.target._schema.returns[0].alias_info is not None:  # through views to their base
+            base = base.args[0]
+        if base in placeholders:
+            raise TypeError(f"{name} writes into {arg_names[placeholders[base]]} in place ({node.target}); the "
+                            "compiled step math must assign new tensors instead")
+
+
+class _Graph:
+    """One traced and compiled specialisation of a :class:`GraphMethod`."""
+
+    __slots__ = ("inputs", "guard", "compiled", "writes", "unflatten", "consts")
+
+    def __init__(self, inputs, guard, compiled, writes, out_spec, consts):
+        self.inputs = inputs      # [(attribute, kind)]: 0 a tensor, 1 a Relational, 2 a tuple of tensors, 3 another pytree
+        self.guard = guard
+        self.compiled = compiled
+        self.writes = writes      # attributes the method assigns, in the order of its outputs
+        self.unflatten = _unflattener(out_spec)  # leaves -> (return value, [written attribute values])
+        # non-tensor leaves of the outputs by position (None where a graph output goes), or None if none
+        self.consts = consts if any(c is not None for c in consts) else None
+
+    def gather(self, owner_dict: dict, args) -> list:
+        flat = [a for a in args if a is not None]
+        for name, kind in self.inputs:
+            v = owner_dict[name]
+            if kind == 0:
+                flat.append(v)
+            elif kind == 1:
+                flat.append(v.data)
+            elif kind == 2:
+                flat.extend(v)
+            else:
+                flat.extend(pytree.tree_leaves(v))
+        return flat
+
+    def run(self, owner_dict: dict, flat: list):
+        outs = self.compiled(*flat)
+        if self.consts is not None:
+            it = iter(outs)
+            outs = [next(it) if c is None else c[0] for c in self.consts]
+        ret, written = self.unflatten(outs)
+        for name, v in zip(self.writes, written):
+            owner_dict[name] = v
+        return ret
+
+
+class GraphMethod:
+    """``method(owner, *args)`` compiled as one graph of its tensor arguments and ``owner``'s tensor
+    state (CPU): what ``torch.compile`` does for the step math, without Dynamo's per-call cost.
+
+    At the first call (and for every new specialisation) the method is traced with ``make_fx`` as a
+    pure function: (arguments, every tensor-valued attribute of ``owner``) -> (return value, every
+    attribute it assigns); attributes the graph does not read are dropped from its inputs. Inductor
+    compiles the graph (its on-disk FX graph cache serves later processes). A call gathers the
+    inputs, checks their shapes, strides and dtypes against the graph's (one C++ check; a mismatch
+    traces a new specialisation), runs the graph and writes the assigned attributes back.
+
+    What the trace bakes in (Dynamo's guards checked these at every call): every Python value the
+    method reads (configuration, reward terms, hand constants, tensors inside other Python objects).
+    They must stay fixed for the life of ``owner``, except the ones ``owner._graph_key()`` returns
+    (optional; a hashable of the values that may change after construction, e.g. at scene
+    rebuilds), which select the specialisation. Calls with a ``None`` argument and with a tensor there are separate
+    specialisations. After ``limit`` specialisations the method runs eagerly (said once)."""
+
+    def __init__(self, owner, fn: Callable, limit: int = RECOMPILE_LIMIT):
+        self._owner = weakref.ref(owner)  # the task holds this object: no reference cycle
+        self._fn = getattr(fn, "__func__", fn)  # the plain function of a bound method
+        self.__name__ = getattr(self._fn, "__name__", "method")
+        self._graphs = {}
+        self._count = 0
+        self._limit = limit
+        self._eager = False
+
+    def eager(self, *args):
+        return self._fn(self._owner(), *args)
+
+    def __call__(self, *args):
+        owner = self._owner()
+        if self._eager:
+            return self._fn(owner, *args)
+        d = owner.__dict__
+        key_fn = getattr(owner, "_graph_key", None)
+        key = (key_fn() if key_fn is not None else None, tuple(a is None for a in args))
+        for g in self._graphs.get(key, ()):
+            flat = g.gather(d, args)
+            if g.guard(flat):
+                return g.run(d, flat)
+        if self._count >= self._limit:
+            self._eager = True
+            print(f"[unicross] {self.__name__}: {self._limit} compiled specialisations; running it eagerly from "
+                  "now on", file=sys.stderr, flush=True)
+            return self._fn(owner, *args)
+        announce = self._count == 0 and _announce_start()
+        t = time.perf_counter()
+        try:
+            g = self._build(owner, args)
+        except Exception as e:  # the trace and the C++ build are optional: eager is always right
+            if not _is_backend_error(e):
+                raise
+            self._eager = True
+            _fall_back(e)
+            return self._fn(owner, *args)
+        self._count += 1
+        self._graphs.setdefault(key, []).append(g)
+        if announce:
+            print(f"[unicross] step math compiled in {time.perf_counter() - t:.1f} s (pid {os.getpid()})",
+                  file=sys.stderr, flush=True)
+        return g.run(d, g.gather(d, args))
+
+    def _build(self, owner, args) -> _Graph:
+        from torch.fx.experimental.proxy_tensor import make_fx
+        from torch._inductor import config as inductor_config
+        from torch._inductor.compile_fx import compile_fx
+
+        d = owner.__dict__
+        names = [n for n, v in d.items() if _is_state(v)]
+        specs = [pytree.tree_flatten(d[n]) for n in names]
+        arg_tensors = [a for a in args if a is not None]
+        example = arg_tensors + [x for leaves, _ in specs for x in leaves]
+        fn, record = self._fn, {}
+
+        def pure(*flat):
+            it = iter(flat)
+            call_args = [None if a is None else next(it) for a in args]
+            saved = dict(d)
+            installed = {}
+            for n, (leaves, spec) in zip(names, specs):
+                installed[n] = d[n] = pytree.tree_unflatten([next(it) for _ in leaves], spec)
+            try:
+                ret = fn(owner, *call_args)
+                writes = [n for n, v in d.items() if v is not installed.get(n, saved.get(n, _MISSING))]
+                bad = [n for n in writes if not _is_state(d[n])]
+                if bad:
+                    raise TypeError(f"{self.__name__} assigns non-tensor attributes {bad}: the compiled step math "
+                                    "may only assign tensors (or tuples/dicts of them) to the task")
+                written = [d[n] for n in writes]
+            finally:
+                d.clear()
+                d.update(saved)
+            leaves, spec = pytree.tree_flatten((ret, written))
+            for x in leaves:
+                if not torch.is_tensor(x) and x is not None and not isinstance(x, (bool, int, float, str)):
+                    raise TypeError(f"{self.__name__} returns a {type(x).__name__}: only tensors and constants")
+            record.update(writes=writes, spec=spec,
+                          consts=[None if torch.is_tensor(x) else (x,) for x in leaves])
+            return [x for x in leaves if torch.is_tensor(x)]
+
+        gm = make_fx(pure, tracing_mode="fake", _allow_non_fake_inputs=True)(*example)
+        _refuse_input_writes(gm, self.__name__, arg_names=[f"argument {k}" for k in range(len(arg_tensors))] +
+                             [n for n, (leaves, _) in zip(names, specs) for _ in leaves])
+        # drop the inputs of attributes the graph does not read
+        placeholders = [n for n in gm.graph.nodes if n.op == "placeholder"]
+        keep_inputs, keep_example, pos = [], list(arg_tensors), len(arg_tensors)
+        for name, (leaves, _) in zip(names, specs):
+            nodes = placeholders[pos:pos + len(leaves)]
+            if any(node.users for node in nodes):
+                keep_inputs.append((name, _kind(d[name])))
+                keep_example.extend(example[pos:pos + len(leaves)])
+            else:
+                for node in nodes:
+                    gm.graph.erase_node(node)
+            pos += len(leaves)
+        gm.graph.lint()
+        gm.recompile()
+        with inductor_config.patch(CPU_OPTIONS):
+            compiled = compile_fx(gm, keep_example)
+        return _Graph(keep_inputs, _InputGuard(keep_example), compiled, record["writes"], record["spec"],
+                      record["consts"])
+
+
+_MISSING = object()
+
+
+def _kind(v) -> int:
+    """How :meth:`_Graph.gather` takes an attribute's tensors: 0 a tensor, 1 a pytree node with one
+    ``data`` leaf (``formulation.Relational``), 2 a tuple of tensors, 3 any other pytree."""
+    if torch.is_tensor(v):
+        return 0
+    if torch.is_tensor(getattr(v, "data", None)) and pytree.tree_leaves(v) == [v.data]:
+        return 1
+    if type(v) is tuple and all(torch.is_tensor(x) for x in v):
+        return 2
+    return 3
+
+
+def _is_backend_error(e: Exception) -> bool:
+    """Errors of the C++ build (no compiler, a failed compile), not of the traced math."""
+    mod = type(e).__module__ or ""
+    return mod.startswith(("torch._inductor", "torch._dynamo", "subprocess")) or isinstance(e, (OSError,))
+
+
+def compile_method(owner, fn: Callable, cpu: bool = True) -> Callable:
+    """The step math ``fn`` (a method of ``owner``) as the ``UNICROSS_COMPILE`` switch says: eager when
+    off; else a :class:`GraphMethod` on the CPU and ``torch.compile`` (:func:`maybe_compile`) on the GPU."""
+    if not compile_enabled():
+        return fn
+    return GraphMethod(owner, fn) if cpu else maybe_compile(fn, cpu=False)

@@ -141,3 +141,29 @@ def load_preset(name: str) -> dict:
         raise ValueError(f"unknown preset {name!r}; valid: {preset_names()}")
     with open(path) as f:
         return yaml.safe_load(f) or {}
+
+
+class FrozenConfig(dict):
+    """A configuration that is fixed once its owner is made (a task's ``cfg``: its compiled step
+    math reads it once, ``unicross.compiling.GraphMethod``). Reads as a dict; every write raises.
+    Copies (``dict(c)``, ``copy.copy``, ``copy.deepcopy``, pickle) are plain, writable dicts."""
+
+    def _refuse(self, *args, **kwargs):
+        raise TypeError("a task's configuration is fixed once the task is made: pass the change when "
+                        "making it (gym.make(..., config={...}) or --set env.task_config.KEY=VALUE)")
+
+    __setitem__ = __delitem__ = update = pop = popitem = setdefault = clear = __ior__ = _refuse
+
+    def __copy__(self):
+        return {k: v for k, v in self.items()}
+
+    def __deepcopy__(self, memo):
+        return {k: copy.deepcopy(v, memo) for k, v in self.items()}
+
+    def __reduce__(self):
+        return dict, (self.__deepcopy__({}),)
+
+
+def freeze(cfg: Mapping) -> FrozenConfig:
+    """``cfg`` with every nested dict as a :class:`FrozenConfig`."""
+    return FrozenConfig({k: freeze(v) if isinstance(v, Mapping) else v for k, v in cfg.items()})

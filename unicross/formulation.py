@@ -24,6 +24,7 @@ import dataclasses
 from typing import Dict, List, Tuple
 
 import torch
+import torch.utils._pytree
 
 from unicross import registry as R
 from unicross.geometry import (
@@ -121,6 +122,11 @@ class Relational:
 
     def where(self, mask: torch.Tensor, other: "Relational") -> "Relational":
         return Relational(torch.where(mask[:, None], self.data, other.data))
+
+
+# a pytree node (one leaf: ``data``), so that traced and compiled step math takes and returns it
+torch.utils._pytree.register_pytree_node(Relational, lambda r: ([r.data], None), lambda leaves, _: Relational(leaves[0]),
+                                         serialized_type_name="unicross.formulation.Relational")
 
 
 def _slot_property(slot):
