@@ -78,9 +78,12 @@ def test_nan_action_raises():
     env = make("UniCross-Grasp-v1")
     env.reset(seed=0)
     a = torch.zeros(22)
-    a[3] = float("nan")
-    with pytest.raises(ValueError):
-        env.step(a)
+    for bad in (float("nan"), float("inf"), -float("inf")):
+        a[3] = bad
+        with pytest.raises(ValueError, match="NaN or inf"):
+            env.step(a)
+    a[:] = 3.0e38  # finite, however large: clamped, not refused
+    env.step(a)
     with pytest.raises(ValueError):
         env.step(torch.zeros(21))
     env.close()
@@ -282,6 +285,24 @@ def test_contact_flags_follow_pressing():
     assert torch.all((c > 0) == (f > u.cfg["contact_force_threshold"]))
     assert torch.all(f[c == 0] <= u.cfg["contact_force_threshold"])
     assert torch.all(dist[c > 0] < 0.03)                 # pressing links are at the surface
+    # the sensor's per-link sums equal a plain per-point loop over every contact, bodies told apart by entity
+    links = {l._bodies[0].entity.per_scene_id: i for i, l in enumerate(u.contact_links)}
+    obj_id, want = u.obj._bodies[0].entity.per_scene_id, torch.zeros(len(links), 3, dtype=torch.float64)
+    for contact in u.scene.px.get_contacts():
+        ids = [b.entity.per_scene_id for b in contact.bodies]
+        for sign, (mine, other) in ((-1.0, ids), (1.0, ids[::-1])):
+            if mine == obj_id and other in links:
+                for point in contact.points:
+                    want[links[other]] += sign * torch.as_tensor(point.impulse, dtype=torch.float64)
+    # the pose read equals SAPIEN's positions and quaternions, body by body
+    pos, quat = u.sensor.poses()
+    for i, comp in enumerate(u.sensor._components):
+        pose = comp.entity_pose
+        assert pos[0, i].tolist() == torch.as_tensor(pose.p, dtype=torch.float32).tolist()
+        assert quat[0, i].tolist() == torch.as_tensor(pose.q, dtype=torch.float32).tolist()
+    got = u.sensor.contact_forces()[0]
+    assert float(want.norm()) > 0
+    torch.testing.assert_close(got.double(), want / u.scene.px.timestep, rtol=1e-5, atol=1e-6)
     # move the object away from the hand: after the next physics step no link is in contact
     obj = u.obj.pose
     u.obj.set_pose(obj.__class__.create_from_pq(obj.p + torch.tensor([0.4, 0.0, 0.0]), obj.q))
