@@ -3,21 +3,23 @@
 For each id the env steps with small random wrist actions and still fingers from a reset
 (relocate/rotate/translate start from a grasp, so the hand holds the object; grasp runs the
 scripted grasp first so the hand holds it too)
-and we time (a) ``env.step`` with the step math eager (``UNICROSS_COMPILE=0``) and compiled
-(``UNICROSS_COMPILE=1``, after its graph is compiled or loaded from the cache) and (b) bare physics
+and we time (a) ``env.step`` with the step math eager (``UNICROSS_COMPILE=0``), compiled
+(``UNICROSS_COMPILE=1``: ``GraphMethod``, after its graph is compiled or loaded from the cache) and
+through ``torch.compile`` (Dynamo; the compiled path before ``GraphMethod``) and (b) bare physics
 of the same scene: the same number of PhysX substeps per control step with no task code. All are
 measured in this one run, interleaved, and reported as steps/s and as ratios to bare physics.
 
 A second table compares the physics settings that decide speed (hand self-collision, contact
 offset) on a holding scene: bare physics control steps/s for each combination.
 
-    python benchmarks/env_throughput.py [--hand allegro] [--steps 300] [--json out.json] [--no-settings]
+    python benchmarks/env_throughput.py [--hand allegro] [--steps 300] [--reps 5] [--json out.json] [--no-settings]
 """
 from __future__ import annotations
 
 import argparse
 import json
 import os
+import statistics
 import sys
 import time
 
@@ -27,11 +29,19 @@ sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 import gymnasium as gym  # noqa: E402
 
 import unicross  # noqa: E402,F401
+import unicross.tasks.base as task_base  # noqa: E402
+from unicross.compiling import compile_method, maybe_compile  # noqa: E402
 from unicross.scripted_grasp import ScriptedGrasp, synthesize  # noqa: E402
 from unicross.objects import get_object_set  # noqa: E402
 
 TASKS = [("UniCross-Grasp-v1", {}), ("UniCross-Relocate-v1", {}), ("UniCross-Rotate-v1", {"axis": "z+"}),
          ("UniCross-Translate-v1", {"direction": "z+"}), ("UniCross-MultiSkill-v1", {})]
+
+
+def _dynamo_method(owner, fn, cpu=True):
+    """The step math through ``torch.compile`` (Dynamo), what ``UNICROSS_COMPILE=1`` ran before
+    ``unicross.compiling.GraphMethod``."""
+    return maybe_compile(fn, cpu=cpu)
 
 
 def _holding_env(task, kw, grasps, objects, hand="allegro", **extra):
@@ -80,6 +90,7 @@ def _time_physics(u, commands, joints):
 def main():
     p = argparse.ArgumentParser()
     p.add_argument("--steps", type=int, default=300)
+    p.add_argument("--reps", type=int, default=5, help="interleaved repetitions; rates are their medians")
     p.add_argument("--json", default=None)
     p.add_argument("--hand", default="allegro")
     p.add_argument("--no-settings", dest="settings", action="store_false", help="skip the physics-settings table")
@@ -94,9 +105,12 @@ def main():
     for task, kw in TASKS:
         built = {}
         try:
-            for mode, flag in (("eager", "0"), ("compiled", "1")):  # UNICROSS_COMPILE is read when an env is made
-                os.environ["UNICROSS_COMPILE"] = flag
+            for mode, flag in (("eager", "0"), ("torch.compile", "1"), ("compiled", "1")):
+                os.environ["UNICROSS_COMPILE"] = flag  # read when an env is made
+                # "torch.compile": the step math through Dynamo, as before GraphMethod (for the comparison)
+                task_base.compile_method = _dynamo_method if mode == "torch.compile" else compile_method
                 env, u = _holding_env(task, kw, gs, objects, hand=args.hand)
+                task_base.compile_method = compile_method
                 _time_env(u, 5)  # the compiled env compiles (or loads its graph) here
                 built[mode] = (env, u, u.get_state_dict())
         except ValueError as e:  # e.g. no elongated grasp for translate
@@ -104,25 +118,30 @@ def main():
             continue
         rates = {m: [] for m in built}
         phys_rates = []
-        for _ in range(3):  # interleave to share machine noise
+        for _ in range(args.reps):  # interleave to share machine noise
             for mode, (env, u, state) in built.items():
                 u.set_state_dict(state)
                 rate, commands, joints, contacts = _time_env(u, args.steps)
                 rates[mode].append(rate)
                 u.set_state_dict(state)
                 phys_rates.append(_time_physics(u, commands, joints))
-        e, c, b = max(rates["eager"]), max(rates["compiled"]), max(phys_rates)
-        rows.append(dict(task=task, eager_steps_per_s=round(e, 1), compiled_steps_per_s=round(c, 1),
-                         bare_physics_steps_per_s=round(b, 1), eager_ratio=round(e / b, 3),
-                         compiled_ratio=round(c / b, 3), contacts=round(contacts, 1)))
+        # medians of the interleaved repetitions (a shared VM's noise: single runs differ by up to ~30%)
+        e, d, c, b = (statistics.median(v) for v in (rates["eager"], rates["torch.compile"], rates["compiled"],
+                                                      phys_rates))
+        rows.append(dict(task=task, eager_steps_per_s=round(e, 1), torch_compile_steps_per_s=round(d, 1),
+                         compiled_steps_per_s=round(c, 1), bare_physics_steps_per_s=round(b, 1),
+                         eager_ratio=round(e / b, 3), torch_compile_ratio=round(d / b, 3),
+                         compiled_ratio=round(c / b, 3), contacts=round(contacts, 1), repetitions=args.reps,
+                         runs={**{m: [round(r, 1) for r in v] for m, v in rates.items()},
+                               "physics": [round(r, 1) for r in phys_rates]}))
         for env, *_ in built.values():
             env.close()
-    print(f"{'task':28s} {'eager/s':>8s} {'compiled/s':>11s} {'physics/s':>10s} {'eager ratio':>12s} "
-          f"{'compiled ratio':>15s} {'links in contact':>17s}")
+    print(f"{'task':28s} {'eager/s':>8s} {'torch.compile/s':>16s} {'compiled/s':>11s} {'physics/s':>10s} "
+          f"{'eager ratio':>12s} {'torch.compile ratio':>20s} {'compiled ratio':>15s} {'links in contact':>17s}")
     for r in rows:
-        print(f"{r['task']:28s} {r['eager_steps_per_s']:8.0f} {r['compiled_steps_per_s']:11.0f} "
-              f"{r['bare_physics_steps_per_s']:10.0f} {r['eager_ratio']:12.2f} {r['compiled_ratio']:15.2f} "
-              f"{r['contacts']:17.1f}")
+        print(f"{r['task']:28s} {r['eager_steps_per_s']:8.0f} {r['torch_compile_steps_per_s']:16.0f} "
+              f"{r['compiled_steps_per_s']:11.0f} {r['bare_physics_steps_per_s']:10.0f} {r['eager_ratio']:12.2f} "
+              f"{r['torch_compile_ratio']:20.2f} {r['compiled_ratio']:15.2f} {r['contacts']:17.1f}")
     settings = []
     for self_collision, offset in ([(True, 0.02), (True, 0.002), (False, 0.02), (False, 0.002)] if args.settings else []):
         env, u = _holding_env("UniCross-Relocate-v1", {}, gs, objects, hand=args.hand,

@@ -260,3 +260,29 @@ def test_graph_method_follows_the_chain_like_torch_compile(monkeypatch):
     for (o0, r0, *_), (o1, r1, *_) in zip(runs["torch.compile"], runs["GraphMethod"]):
         torch.testing.assert_close(o1, o0, atol=1e-6, rtol=1e-6)
         torch.testing.assert_close(r1, r0, atol=1e-6, rtol=1e-6)
+
+
+def test_graph_method_shares_graphs_between_owners_with_one_context():
+    class Shared(_Toy):
+        def _graph_context(self):
+            return f"toy scale={self.scale}"
+
+    class Forgetful(_Toy):  # a context that misses a value the graph bakes in
+        def _graph_context(self):
+            return "toy, scale left out"
+
+    a, b = Shared(), Shared()
+    twin = _eager_twin(b)
+    a.math(torch.ones(2))
+    got = b.math(torch.ones(2))                  # b's first call: a's graph, checked against eager
+    torch.testing.assert_close(got[0]["y"], _Toy.step(twin, torch.ones(2))[0]["y"])
+    assert (a.math._count, b.math._count) == (1, 0)
+    c = Shared()
+    c.scale = 5.0                                # another context: its own graph
+    c.math(torch.ones(2))
+    assert c.math._count == 1
+    f1, f2 = Forgetful(), Forgetful()
+    f2.scale = 7.0
+    f1.math(torch.ones(2))
+    with pytest.raises(RuntimeError, match="misses a value"):
+        f2.math(torch.ones(2))

@@ -236,6 +236,11 @@ class _Graph:
         return ret
 
 
+# graphs shared by the tasks of a process whose ``_graph_context()`` is equal (evaluation makes one
+# task per object and axis): {(method, context, key, argument pattern): [_Graph]}
+_SHARED: dict = {}
+
+
 class GraphMethod:
     """``method(owner, *args)`` compiled as one graph of its tensor arguments and ``owner``'s tensor
     state (CPU): what ``torch.compile`` does for the step math, without Dynamo's per-call cost.
@@ -251,14 +256,23 @@ class GraphMethod:
     method reads (configuration, reward terms, hand constants, tensors inside other Python objects).
     They must stay fixed for the life of ``owner``, except the ones ``owner._graph_key()`` returns
     (optional; a hashable of the values that may change after construction, e.g. at scene
-    rebuilds), which select the specialisation. Calls with a ``None`` argument and with a tensor there are separate
-    specialisations. After ``limit`` specialisations the method runs eagerly (said once)."""
+    rebuilds), which select the specialisation. Calls with a ``None`` argument and with a tensor
+    there are separate specialisations. After ``limit`` specialisations the method runs eagerly
+    (said once).
+
+    Owners with an equal ``owner._graph_context()`` (optional; a string naming everything fixed at
+    construction that the trace may bake in: class, configuration, hand, ...) share their graphs
+    within the process, so a new task costs no trace. The first call of each owner on a graph it
+    did not trace also runs the method eagerly and compares (1e-4): a context that misses a value
+    the graph baked in raises instead of computing something else."""
 
     def __init__(self, owner, fn: Callable, limit: int = RECOMPILE_LIMIT):
         self._owner = weakref.ref(owner)  # the task holds this object: no reference cycle
         self._fn = getattr(fn, "__func__", fn)  # the plain function of a bound method
         self.__name__ = getattr(self._fn, "__name__", "method")
-        self._graphs = {}
+        self._graphs = None   # this owner's {(key, argument pattern): [_Graph]}, shared when it has a context
+        self._context = None
+        self._checked = set()  # ids of shared graphs this owner has compared with the eager method
         self._count = 0
         self._limit = limit
         self._eager = False
@@ -266,18 +280,30 @@ class GraphMethod:
     def eager(self, *args):
         return self._fn(self._owner(), *args)
 
+    def _table(self, owner) -> dict:
+        ctx_fn = getattr(owner, "_graph_context", None)
+        if ctx_fn is None:
+            return {}
+        self._context = (self._fn.__module__, self._fn.__qualname__, ctx_fn())
+        return _SHARED.setdefault(self._context, {})
+
     def __call__(self, *args):
         owner = self._owner()
         if self._eager:
             return self._fn(owner, *args)
+        if self._graphs is None:
+            self._graphs = self._table(owner)
         d = owner.__dict__
         key_fn = getattr(owner, "_graph_key", None)
         key = (key_fn() if key_fn is not None else None, tuple(a is None for a in args))
-        for g in self._graphs.get(key, ()):
+        graphs = self._graphs.setdefault(key, [])
+        for g in graphs:
             flat = g.gather(d, args)
             if g.guard(flat):
+                if self._context is not None and id(g) not in self._checked:
+                    return self._run_checked(owner, g, args, flat)
                 return g.run(d, flat)
-        if self._count >= self._limit:
+        if len(graphs) >= self._limit:
             self._eager = True
             print(f"[unicross] {self.__name__}: {self._limit} compiled specialisations; running it eagerly from "
                   "now on", file=sys.stderr, flush=True)
@@ -293,11 +319,33 @@ class GraphMethod:
             _fall_back(e)
             return self._fn(owner, *args)
         self._count += 1
-        self._graphs.setdefault(key, []).append(g)
+        self._checked.add(id(g))
+        graphs.append(g)
         if announce:
             print(f"[unicross] step math compiled in {time.perf_counter() - t:.1f} s (pid {os.getpid()})",
                   file=sys.stderr, flush=True)
         return g.run(d, g.gather(d, args))
+
+    def _run_checked(self, owner, g: _Graph, args, flat):
+        """The first call of this owner on a graph another owner traced: the eager method on the same
+        state must agree (then the graph's result and writes are kept)."""
+        d = owner.__dict__
+        saved = dict(d)
+        want = self._fn(owner, *args)
+        want_state = {n: d.get(n) for n in g.writes}
+        d.clear()
+        d.update(saved)
+        got = g.run(d, flat)
+        try:
+            tensors = [[x for x in pytree.tree_leaves(v) if torch.is_tensor(x)]
+                       for v in ((got, [d[n] for n in g.writes]), (want, [want_state[n] for n in g.writes]))]
+            torch.testing.assert_close(tensors[0], tensors[1], rtol=1e-4, atol=1e-4, equal_nan=True)
+        except AssertionError as e:
+            raise RuntimeError(f"{self.__name__}: the compiled graph shared by tasks with the same _graph_context() "
+                               f"disagrees with the eager method for {type(owner).__name__}: the context misses a "
+                               f"value the graph depends on.\n{e}") from None
+        self._checked.add(id(g))
+        return got
 
     def _build(self, owner, args) -> _Graph:
         from torch.fx.experimental.proxy_tensor import make_fx
