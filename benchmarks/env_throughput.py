@@ -12,7 +12,7 @@ measured in this one run, interleaved, and reported as steps/s and as ratios to 
 A second table compares the physics settings that decide speed (hand self-collision, contact
 offset) on a holding scene: bare physics control steps/s for each combination.
 
-    python benchmarks/env_throughput.py [--hand allegro] [--steps 300] [--reps 5] [--json out.json] [--no-settings]
+    python benchmarks/env_throughput.py [--hand allegro] [--steps 300] [--reps 5] [--breakdown] [--json out.json] [--no-settings]
 """
 from __future__ import annotations
 
@@ -75,6 +75,34 @@ def _time_env(u, steps, seed=0):
     return rate, targets, joints, float(contacts.item()) / steps
 
 
+TIMED = ("_command_math", "_apply_command", "_step_action", "_read", "_step_math", "get_info")
+
+
+def _breakdown(u, steps):
+    """Per-step microseconds of the parts of ``env.step`` (``TIMED``; ``_step_action`` holds the
+    PhysX substeps, ``get_info`` the reads and the step math), timed inside the step loop."""
+    spent = dict.fromkeys(TIMED, 0.0)
+    own = {name: u.__dict__[name] for name in TIMED if name in u.__dict__}  # the task's compiled methods
+    for name in TIMED:
+        fn = getattr(u, name)
+
+        def timed(*a, _fn=fn, _name=name, **k):
+            t = time.perf_counter()
+            out = _fn(*a, **k)
+            spent[_name] += time.perf_counter() - t
+            return out
+        setattr(u, name, timed)
+    try:
+        rate, *_ = _time_env(u, steps)
+    finally:
+        for name in TIMED:
+            if name in own:
+                setattr(u, name, own[name])
+            else:
+                delattr(u, name)  # the class's method again
+    return dict(step=round(1e6 / rate, 1), **{k: round(v / steps * 1e6, 1) for k, v in spent.items()})
+
+
 def _time_physics(u, commands, joints):
     """Bare physics of the same scene: the same drive targets, PhysX substeps, no task code."""
     k = u._sim_steps_per_control
@@ -93,6 +121,8 @@ def main():
     p.add_argument("--reps", type=int, default=5, help="interleaved repetitions; rates are their medians")
     p.add_argument("--json", default=None)
     p.add_argument("--hand", default="allegro")
+    p.add_argument("--breakdown", action="store_true",
+                   help="also time the parts of a compiled step inside the loop (us per step)")
     p.add_argument("--no-settings", dest="settings", action="store_false", help="skip the physics-settings table")
     args = p.parse_args()
     torch.set_num_threads(1)
@@ -134,6 +164,11 @@ def main():
                          compiled_ratio=round(c / b, 3), contacts=round(contacts, 1), repetitions=args.reps,
                          runs={**{m: [round(r, 1) for r in v] for m, v in rates.items()},
                                "physics": [round(r, 1) for r in phys_rates]}))
+        if args.breakdown:
+            u, state = built["compiled"][1:]
+            u.set_state_dict(state)
+            rows[-1]["compiled_breakdown_us"] = _breakdown(u, args.steps)
+            print(f"{task}: compiled step, us per step: {rows[-1]['compiled_breakdown_us']}")
         for env, *_ in built.values():
             env.close()
     print(f"{'task':28s} {'eager/s':>8s} {'torch.compile/s':>16s} {'compiled/s':>11s} {'physics/s':>10s} "
