@@ -5,7 +5,8 @@ For each id the env steps with small random wrist actions and still fingers from
 scripted grasp first so the hand holds it too)
 and we time (a) ``env.step`` with the step math eager (``UNICROSS_COMPILE=0``), compiled
 (``UNICROSS_COMPILE=1``: ``GraphMethod``, after its graph is compiled or loaded from the cache) and
-through ``torch.compile`` (Dynamo; the compiled path before ``GraphMethod``) and (b) bare physics
+through ``torch.compile`` (``UNICROSS_COMPILE=torch``: Dynamo, the compiled path before
+``GraphMethod``) and (b) bare physics
 of the same scene: the same number of PhysX substeps per control step with no task code. All are
 measured in this one run, interleaved, and reported as steps/s and as ratios to bare physics.
 
@@ -29,19 +30,11 @@ sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 import gymnasium as gym  # noqa: E402
 
 import unicross  # noqa: E402,F401
-import unicross.tasks.base as task_base  # noqa: E402
-from unicross.compiling import compile_method, maybe_compile  # noqa: E402
 from unicross.scripted_grasp import ScriptedGrasp, synthesize  # noqa: E402
 from unicross.objects import get_object_set  # noqa: E402
 
 TASKS = [("UniCross-Grasp-v1", {}), ("UniCross-Relocate-v1", {}), ("UniCross-Rotate-v1", {"axis": "z+"}),
          ("UniCross-Translate-v1", {"direction": "z+"}), ("UniCross-MultiSkill-v1", {})]
-
-
-def _dynamo_method(owner, fn, cpu=True):
-    """The step math through ``torch.compile`` (Dynamo), what ``UNICROSS_COMPILE=1`` ran before
-    ``unicross.compiling.GraphMethod``."""
-    return maybe_compile(fn, cpu=cpu)
 
 
 def _holding_env(task, kw, grasps, objects, hand="allegro", **extra):
@@ -135,12 +128,9 @@ def main():
     for task, kw in TASKS:
         built = {}
         try:
-            for mode, flag in (("eager", "0"), ("torch.compile", "1"), ("compiled", "1")):
+            for mode, flag in (("eager", "0"), ("torch.compile", "torch"), ("compiled", "1")):
                 os.environ["UNICROSS_COMPILE"] = flag  # read when an env is made
-                # "torch.compile": the step math through Dynamo, as before GraphMethod (for the comparison)
-                task_base.compile_method = _dynamo_method if mode == "torch.compile" else compile_method
                 env, u = _holding_env(task, kw, gs, objects, hand=args.hand)
-                task_base.compile_method = compile_method
                 _time_env(u, 5)  # the compiled env compiles (or loads its graph) here
                 built[mode] = (env, u, u.get_state_dict())
         except ValueError as e:  # e.g. no elongated grasp for translate

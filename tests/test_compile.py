@@ -231,16 +231,10 @@ def test_graph_method_follows_the_chain_like_torch_compile(monkeypatch):
     The compiled env follows it (``_graph_key``): step by step it gives what ``torch.compile`` gives
     (whose guards re-check every Python value at every call). Eager is no reference here: contact
     amplifies the ~1e-7 compiled-vs-eager differences to 1e-1 within a few steps of the grasp."""
-    import unicross.tasks.base as base
     from unicross.scripted_grasp import ScriptedGrasp
-    monkeypatch.setenv("UNICROSS_COMPILE", "1")
     runs = {}
-    for name in ("torch.compile", "GraphMethod"):
-        if name == "torch.compile":
-            monkeypatch.setattr(base, "compile_method", lambda owner, fn, cpu=True: maybe_compile(fn, cpu=cpu))
-        else:
-            monkeypatch.undo()
-            monkeypatch.setenv("UNICROSS_COMPILE", "1")
+    for name, flag in (("torch.compile", "torch"), ("GraphMethod", "1")):
+        monkeypatch.setenv("UNICROSS_COMPILE", flag)
         env = make("UniCross-Chain-v1", objects="test-wrappable", sequence="grasp,relocate,rotate:y-",
                    phase_steps=dict(grasp=60, relocate=10, rotate=10), randomize=False)
         u = env.unwrapped

@@ -13,7 +13,8 @@ arguments and the task's tensor state and compiled by Inductor without Dynamo: D
 ~700 guards and replayed the method's attribute writes in Python at every call, ~250 us per call
 around ~140 us of kernels (rotate, step math). The graph runs through Inductor's C++ wrapper
 without its size asserts; one C++ check of the inputs' shapes, strides and dtypes guards it.
-On the GPU the methods go through ``torch.compile`` (:func:`maybe_compile`).
+On the GPU, or with ``UNICROSS_COMPILE=torch``, the methods go through ``torch.compile``
+(:func:`maybe_compile`).
 """
 from __future__ import annotations
 
@@ -36,6 +37,12 @@ _ANNOUNCED = False
 def compile_enabled() -> bool:
     """The ``UNICROSS_COMPILE`` switch: on unless set to 0/false/off/no."""
     return os.environ.get("UNICROSS_COMPILE", "1").strip().lower() not in ("0", "false", "off", "no")
+
+
+def compile_with_dynamo() -> bool:
+    """``UNICROSS_COMPILE=torch``: the CPU step math through ``torch.compile`` (Dynamo) instead of
+    :class:`GraphMethod` (slower per call; for comparisons, e.g. ``benchmarks/env_throughput.py``)."""
+    return os.environ.get("UNICROSS_COMPILE", "1").strip().lower() == "torch"
 
 
 def _announce_start() -> bool:
@@ -431,7 +438,8 @@ def _is_backend_error(e: Exception) -> bool:
 
 def compile_method(owner, fn: Callable, cpu: bool = True) -> Callable:
     """The step math ``fn`` (a method of ``owner``) as the ``UNICROSS_COMPILE`` switch says: eager when
-    off; else a :class:`GraphMethod` on the CPU and ``torch.compile`` (:func:`maybe_compile`) on the GPU."""
+    off; else a :class:`GraphMethod` on the CPU and ``torch.compile`` (:func:`maybe_compile`) on the
+    GPU or with ``UNICROSS_COMPILE=torch``."""
     if not compile_enabled():
         return fn
-    return GraphMethod(owner, fn) if cpu else maybe_compile(fn, cpu=False)
+    return GraphMethod(owner, fn) if cpu and not compile_with_dynamo() else maybe_compile(fn, cpu=cpu)
