@@ -280,3 +280,25 @@ def test_graph_method_shares_graphs_between_owners_with_one_context():
     f1.math(torch.ones(2))
     with pytest.raises(RuntimeError, match="misses a value"):
         f2.math(torch.ones(2))
+
+
+def test_tracing_leaves_no_fake_constants_behind():
+    """Geometry caches its constants per device and dtype; a trace (fake tensors) must not fill that
+    cache, or the next eager call would compute with fake tensors."""
+    from unicross import geometry as G
+
+    class Q:
+        def __init__(self):
+            self.q = torch.tensor([[0.6, 0.8, 0.0, 0.0]], dtype=torch.float64)
+            self.math = GraphMethod(self, Q.step)
+
+        def step(self, r):
+            self.q = G.quat_mul(self.q, r)
+            return self.q
+
+    G._CACHE.clear()
+    r = torch.tensor([[0.0, 0.0, 1.0, 0.0]], dtype=torch.float64)
+    owner = Q()
+    got = owner.math(r)
+    assert all(type(c) is torch.Tensor for c in G._CACHE.values())
+    torch.testing.assert_close(got, G.quat_mul(torch.tensor([[0.6, 0.8, 0.0, 0.0]], dtype=torch.float64), r))

@@ -34,9 +34,10 @@ _CACHE: dict = {}
 def _const(t: torch.Tensor, like: torch.Tensor) -> torch.Tensor:
     """``t`` on ``like``'s device (and float dtype), cached per (constant, device, dtype) when eager;
     under torch.compile the conversion is traced into the graph instead (a lookup in the cache
-    would become a guard evaluated in Python at every call)."""
+    would become a guard evaluated in Python at every call), and while ``make_fx`` traces
+    (``unicross.compiling.GraphMethod``: ``like`` is a fake tensor) it is not cached either."""
     dtype = like.dtype if t.is_floating_point() else t.dtype
-    if torch.compiler.is_compiling():
+    if torch.compiler.is_compiling() or type(like) is not torch.Tensor:
         return t.to(device=like.device, dtype=dtype)
     key = (id(t), like.device, like.dtype)
     c = _CACHE.get(key)
