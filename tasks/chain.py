@@ -71,6 +71,9 @@ class ChainEnv(UniCrossEnv):
 
     TASK_STATE = UniCrossEnv.TASK_STATE + ("phase", "phase_success")
 
+    def _graph_context(self) -> str:
+        return repr((super()._graph_context(), self.sequence, self.phase_lengths))
+
     def _alloc_buffers(self):
         super()._alloc_buffers()
         n, dev, p = self.num_envs, self.device, len(self.sequence)

@@ -37,12 +37,11 @@ class StepMath:
         """Everything fixed when the task is made that the compiled step math may bake in (class,
         hand, configuration, reward configuration, modes, sizes): tasks with the same context share
         their compiled graphs in a process (``unicross.compiling.GraphMethod``; evaluation makes a
-        task per object and axis)."""
+        task per object and axis). A subclass with more such values adds them."""
         return repr((type(self).__module__, type(self).__qualname__, self.hand_spec,
                      json.dumps(self.cfg, sort_keys=True, default=repr),
                      json.dumps(self.reward_cfg, sort_keys=True, default=repr), tuple(self.modes_used),
-                     self.num_envs, str(self.device), self._sim_steps_per_control, self._control_freq,
-                     getattr(self, "sequence", None), getattr(self, "phase_lengths", None)))
+                     self.num_envs, str(self.device), self._sim_steps_per_control, self._control_freq))
 
     def _command_math_eager(self, a: torch.Tensor, elapsed_steps: torch.Tensor, perturb_normal=None,
                             perturb_uniform=None):

@@ -160,9 +160,9 @@ class _InputGuard:
 
 def _unflattener(spec) -> Callable[[list], object]:
     """``leaves -> pytree`` for ``spec`` as one generated expression (~10x faster than
-    ``pytree.tree_unflatten`` for the step math's outputs); other node types fall back to it."""
-    names = {"Relational": None}
-    counter = [0]
+    ``pytree.tree_unflatten`` for the step math's outputs): dicts, tuples and lists as literals,
+    other registered nodes (``formulation.Relational``) through their own unflatten function."""
+    names, counter = {}, [0]
 
     def expr(sp) -> str:
         if sp.is_leaf():
@@ -175,16 +175,11 @@ def _unflattener(spec) -> Callable[[list], object]:
             return "(" + "".join(f"{v}, " for v in kids) + ")"
         if sp.type is list:
             return "[" + ", ".join(kids) + "]"
-        if sp.type.__name__ == "Relational" and len(kids) == 1:
-            names["Relational"] = sp.type
-            return f"Relational({kids[0]})"
-        raise NotImplementedError(sp.type)
+        k = len(names)
+        names[f"_u{k}"], names[f"_c{k}"] = pytree.SUPPORTED_NODES[sp.type].unflatten_fn, sp.context
+        return f"_u{k}([{', '.join(kids)}], _c{k})"
 
-    try:
-        code = expr(spec)
-    except NotImplementedError:
-        return lambda leaves: pytree.tree_unflatten(leaves, spec)
-    return eval(f"lambda L: {code}", names)  # noqa: S307 - generated from the spec's own types and keys
+    return eval(f"lambda L: {expr(spec)}", names)  # noqa: S307 - generated from the spec's own types and keys
 
 
 def _refuse_input_writes(gm, name: str, arg_names: List[str]) -> None:
@@ -244,7 +239,7 @@ class _Graph:
 
 
 # graphs shared by the tasks of a process whose ``_graph_context()`` is equal (evaluation makes one
-# task per object and axis): {(method, context, key, argument pattern): [_Graph]}
+# task per object and axis): {(module, method, context): {(key, argument pattern): [_Graph]}}
 _SHARED: dict = {}
 
 
@@ -283,9 +278,6 @@ class GraphMethod:
         self._count = 0
         self._limit = limit
         self._eager = False
-
-    def eager(self, *args):
-        return self._fn(self._owner(), *args)
 
     def _table(self, owner) -> dict:
         ctx_fn = getattr(owner, "_graph_context", None)
