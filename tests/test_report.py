@@ -9,9 +9,10 @@ def test_report_paper_one_trial(tmp_path):
     from unicross.objects import get_object_set
     from unicross.report import _cell, shipped
     out = tmp_path / "results.md"
-    assert main(["report", "--paper", "--limit", "1", "--trials-per-object", "1", "--out", str(out)]) == 0
+    assert main(["report", "--paper", "--limit", "1", "--trials-per-object", "1", "--min-trials", "0",
+                 "--out", str(out)]) == 0
     text = out.read_text()
-    assert text.splitlines()[2].startswith("Command: `unicross report")
+    assert text.splitlines()[2].startswith("Command: `unicross report") and "--min-trials 0" in text.splitlines()[2]
     for title in ("Experts, held-out test objects", "Student, held-out test objects", "Unseen objects",
                   "Disturbances", "Baselines", "Long horizon"):
         assert f"## {title}" in text
@@ -32,8 +33,18 @@ def test_report_paper_one_trial(tmp_path):
         assert f"| {mode} | zero | " in text
 
 
+def test_report_raises_trials_to_the_minimum():
+    """A cell over few objects gets more trials per object, never fewer than asked."""
+    from unicross.report import PaperReport
+    r = PaperReport(trials=3, min_trials=100)
+    assert [r.trials_per_object(n) for n in (40, 34, 20, 10, 7, 200)] == [3, 3, 5, 10, 15, 3]
+    assert all(n * r.trials_per_object(n) >= 100 for n in range(1, 120))
+    assert PaperReport(trials=2, min_trials=0).trials_per_object(5) == 2
+
+
 @pytest.mark.parametrize("argv,msg", [
     (["report", "--paper", "--trials-per-object", "0"], ">= 1"),
+    (["report", "--paper", "--min-trials", "-1"], ">= 0"),
     (["report", "--paper", "some.json"], "takes no eval JSON files"),
     (["report"], "--paper"),
 ])

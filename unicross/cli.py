@@ -410,8 +410,9 @@ def _cmd_report_paper(args) -> int:
     from unicross.report import paper_report
     if args.files:
         raise ValueError("report --paper evaluates the shipped checkpoints; it takes no eval JSON files")
-    if args.trials_per_object < 1 or args.limit < 0 or args.workers < 1:
-        raise ValueError("--trials-per-object and --workers must be >= 1, --limit >= 0 (0: every object)")
+    if args.trials_per_object < 1 or args.limit < 0 or args.workers < 1 or args.min_trials < 0:
+        raise ValueError("--trials-per-object and --workers must be >= 1, --limit and --min-trials >= 0 "
+                         "(--limit 0: every object)")
     out = Path(args.out or "docs/results.md")
     out.parent.mkdir(parents=True, exist_ok=True)
     if out.is_dir():
@@ -419,9 +420,10 @@ def _cmd_report_paper(args) -> int:
     with open(out, "a"):  # writable, checked before any simulation
         pass
     argv = ["report", "--paper", "--hand", args.hand, "--limit", str(args.limit), "--trials-per-object",
-            str(args.trials_per_object), "--workers", str(args.workers), "--seed", str(args.seed), "--out", str(out)]
-    paper_report(str(out), argv, hand=args.hand, limit=args.limit or None,
-                 trials=args.trials_per_object, workers=args.workers, seed=args.seed)
+            str(args.trials_per_object), "--min-trials", str(args.min_trials), "--workers", str(args.workers),
+            "--seed", str(args.seed), "--out", str(out)]
+    paper_report(str(out), argv, hand=args.hand, limit=args.limit or None, trials=args.trials_per_object,
+                 min_trials=args.min_trials, workers=args.workers, seed=args.seed)
     print(f"wrote {out}")
     return 0
 
@@ -560,6 +562,8 @@ def main(argv=None) -> int:
     s.add_argument("--hand", default="allegro")
     s.add_argument("--limit", type=natural, default=10, help="--paper: first N objects per (category, shape) group (0: all, the paper's full sets)")
     s.add_argument("--trials-per-object", type=positive, default=3, help="--paper: trials per object and axis")
+    s.add_argument("--min-trials", type=natural, default=100,
+                   help="--paper: raise the trials per object of a cell until it has at least N trials (0: off)")
     s.add_argument("--workers", type=positive, default=1, help="--paper: processes per evaluation")
     s.add_argument("--seed", type=int, default=0)
     s.set_defaults(fn=_cmd_report)

@@ -188,6 +188,30 @@ def _env_for(protocol: str, axis: Optional[str], obj: ObjectSpec, hand: str, dis
     return gym.make(sk.env_id, **kw)
 
 
+def protocol_objects(protocol: str, objects: Sequence[ObjectSpec], hand: str = "allegro", grasp_dataset=None):
+    """The objects of ``objects`` that ``protocol`` evaluates, and the grasp dataset it starts from:
+    the skill's categories, and for the in-hand protocols only objects with a grasp state (a warning
+    names the others). Raises ``ValueError`` when none is left."""
+    sk = R.skill(protocol)
+    objs = [o for o in objects if o.category in sk.categories]
+    if not objs:
+        raise ValueError(f"no {' or '.join(sk.categories)} object in the set for protocol {protocol!r}")
+    if protocol != "grasp":  # in-hand protocols start from grasps: objects without one cannot be evaluated
+        from unicross.grasps import GraspSet, default_grasp_path
+        gs = grasp_dataset if isinstance(grasp_dataset, GraspSet) else \
+            GraspSet.load(grasp_dataset or default_grasp_path(hand))
+        grasp_dataset = gs  # loaded once for all the protocol's envs
+        have = {n for n, c in gs.counts().items() if c > 0}
+        lacking = [o.name for o in objs if o.name not in have]
+        if len(lacking) == len(objs):
+            raise ValueError(f"the grasp dataset has no grasp of any {protocol} object ({lacking[:3]}...); "
+                             f"build them with `unicross grasps --hand {hand} --objects <set>`")
+        if lacking:
+            logger.warning(f"{protocol}: {len(lacking)} object(s) without a grasp are not evaluated: {lacking}")
+            objs = [o for o in objs if o.name in have]
+    return objs, grasp_dataset
+
+
 def run_protocol(protocol: str, policy: PolicyFn, objects: Sequence[ObjectSpec], hand: str = "allegro",
                  trials_per_object: int = EVAL_CFG["trials_per_object"], seed: int = 0, disturb: bool = False, randomize: bool = False,
                  grasp_dataset=None, original: bool = False, progress: bool = True,
@@ -206,22 +230,7 @@ def run_protocol(protocol: str, policy: PolicyFn, objects: Sequence[ObjectSpec],
     if bad:
         raise ValueError(f"axes {bad} are not axes of protocol {protocol!r}: {all_axes}")
     axes = list(axes) if axes else all_axes
-    objs = [o for o in objects if o.category in sk.categories]
-    if not objs:
-        raise ValueError(f"no {' or '.join(sk.categories)} object in the set for protocol {protocol!r}")
-    if protocol != "grasp":  # in-hand protocols start from grasps: objects without one cannot be evaluated
-        from unicross.grasps import GraspSet, default_grasp_path
-        gs = grasp_dataset if isinstance(grasp_dataset, GraspSet) else \
-            GraspSet.load(grasp_dataset or default_grasp_path(hand))
-        grasp_dataset = gs  # loaded once for all the protocol's envs
-        have = {n for n, c in gs.counts().items() if c > 0}
-        lacking = [o.name for o in objs if o.name not in have]
-        if len(lacking) == len(objs):
-            raise ValueError(f"the grasp dataset has no grasp of any {protocol} object ({lacking[:3]}...); "
-                             f"build them with `unicross grasps --hand {hand} --objects <set>`")
-        if lacking:
-            logger.warning(f"{protocol}: {len(lacking)} object(s) without a grasp are not evaluated: {lacking}")
-            objs = [o for o in objs if o.name in have]
+    objs, grasp_dataset = protocol_objects(protocol, objects, hand, grasp_dataset)
     steps = sk.protocol_steps
     trials = []
     mine = [oi for oi in range(len(objs)) if shard is None or oi % shard[1] == shard[0]]
