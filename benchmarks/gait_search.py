@@ -22,9 +22,15 @@ the rotate success test accumulates, about all three axes) and displacement in t
 
 ``--one-finger`` keeps three fingers still (each at its own bias, e.g. tightened) and moves one:
 a ratchet that might turn the object a little per cycle without loosening the grasp.
-``--refine AXIS`` (e.g. ``z+``; rotation only) runs a cross-entropy search from the zero gait
-instead, scoring each episode by its accumulated rotation about AXIS (capped at 3 rad) and a drop
-as -1. Episodes run in two spawned worker processes, one env per object each.
+``--refine AXIS`` (e.g. ``z+``) runs a cross-entropy search from the zero gait instead, scoring each
+episode by its accumulated rotation about AXIS in units of the success angle (rotate; capped at 2)
+or its displacement along AXIS in units of the success distance (translate; capped at 2), a drop
+as -1 (``--init FILE``: start from the best gait of a log instead):
+
+    python benchmarks/gait_search.py --skill translate --axis z- --refine z- --steps 64 --amplitude 0.6 \
+        --no-randomize --limit 2 --generations 30 --out docs/runs/gait_search/translate_zm_refine.jsonl
+
+Episodes run in two spawned worker processes, one env per object each.
 """
 from __future__ import annotations
 
@@ -150,7 +156,8 @@ def main():
     ap.add_argument("--one-finger", action="store_true",
                     help="gait i moves finger i mod 4 only (index, middle, ring, thumb); the others keep their bias")
     ap.add_argument("--no-randomize", action="store_true", help="the evaluation's conditions (default: training's)")
-    ap.add_argument("--refine", default=None, help="cross-entropy search for rotation about this axis (x+ ... z-)")
+    ap.add_argument("--init", default=None, help="--refine: start from the best gait of this log (same score)")
+    ap.add_argument("--refine", default=None, help="cross-entropy search for motion along / about this axis (x+ ... z-)")
     ap.add_argument("--generations", type=int, default=10)
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--out", default=None)
@@ -182,19 +189,30 @@ def main():
                       flush=True)
             return
         comp, sign = "xyz".index(args.refine[0]), 1.0 if args.refine[1] == "+" else -1.0
+        from unicross.config import load_config
+        sc = load_config("task")["success"]
+        # accumulated rotation (columns 0-2) in success angles, or displacement (3-5) in success distances
+        col, unit = (comp, sc["rotate_angle"]) if args.skill == "rotate" else (3 + comp, sc["translate_dist"])
         mu, sig, pop = np.zeros(NPAR), np.full(NPAR, 0.35), 16
+        if args.init:
+            rows = [json.loads(line) for line in (gzip.open if args.init.endswith(".gz") else open)(args.init, "rt")]
+            res0 = np.array([r["r"] for r in rows])
+            s0 = np.where(res0[:, :, 6] > 0, -1.0, (sign * res0[:, :, col] / unit).clip(-2, 2)).mean(1)
+            mu = np.array(rows[int(np.argmax(s0))]["p"])
+            print(f"starting from the best gait of {args.init} (score {s0.max():.3f})", flush=True)
         for g in range(args.generations):
             gaits = np.clip(mu + sig * rng.standard_normal((pop, NPAR)), -1, 1)
             gaits[0] = mu
             res = evaluate(pool, gaits, args, n_obj)
-            score = np.where(res[:, :, 6] > 0, -1.0, (sign * res[:, :, comp]).clip(-3, 3)).mean(1)
+            score = np.where(res[:, :, 6] > 0, -1.0, (sign * res[:, :, col] / unit).clip(-2, 2)).mean(1)
             elite = np.argsort(-score)[:pop // 4]
             mu, sig = gaits[elite].mean(0), np.maximum(gaits[elite].std(0), 0.05)
             for p, r, s in zip(gaits, res, score):
                 log.write(json.dumps(dict(meta=meta, generation=g, p=p.tolist(), r=r.tolist(), score=float(s))) + "\n")
             log.flush()
             print(f"generation {g}: best score {score.max():.3f} (the mean gait {score[0]:.3f}), "
-                  f"its rotation {np.round(res[elite[0], :, comp], 2).tolist()}", flush=True)
+                  f"its {'rotation' if args.skill == 'rotate' else 'displacement'} "
+                  f"{np.round(res[elite[0], :, col], 3).tolist()}, dropped {res[elite[0], :, 6].mean():.0%}", flush=True)
 
 
 if __name__ == "__main__":

@@ -151,7 +151,9 @@ class PaperReport:
                                          resolve_policy, sr_cell)
         policy, _ = resolve_policy(self.ckpts["student"], self.hand)
         objs = get_object_set("test", limit=self.limit)
-        trials = run_chain(policy, objs, hand=self.hand, trials_per_object=self.trials_per_object(len(objs)),
+        # the paper's sequences split the objects: wrappable ones rotate, elongated ones translate
+        per_sequence = min(sum(o.category == c for o in objs) for c in {o.category for o in objs})
+        trials = run_chain(policy, objs, hand=self.hand, trials_per_object=self.trials_per_object(per_sequence),
                            seed=self.seed, progress=False)
         missing = [m for m in F.MODES if m not in self.student_modes]
         note = ([f"The student was distilled for {', '.join(self.student_modes)} only (no expert for "
