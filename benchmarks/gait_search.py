@@ -193,18 +193,21 @@ def main():
         sc = load_config("task")["success"]
         # accumulated rotation (columns 0-2) in success angles, or displacement (3-5) in success distances
         col, unit = (comp, sc["rotate_angle"]) if args.skill == "rotate" else (3 + comp, sc["translate_dist"])
+
+        def scores(res):  # per gait: mean over its episodes, a drop -1
+            return np.where(res[:, :, 6] > 0, -1.0, (sign * res[:, :, col] / unit).clip(-2, 2)).mean(1)
+
         mu, sig, pop = np.zeros(NPAR), np.full(NPAR, 0.35), 16
         if args.init:
             rows = [json.loads(line) for line in (gzip.open if args.init.endswith(".gz") else open)(args.init, "rt")]
-            res0 = np.array([r["r"] for r in rows])
-            s0 = np.where(res0[:, :, 6] > 0, -1.0, (sign * res0[:, :, col] / unit).clip(-2, 2)).mean(1)
+            s0 = scores(np.array([r["r"] for r in rows]))
             mu = np.array(rows[int(np.argmax(s0))]["p"])
             print(f"starting from the best gait of {args.init} (score {s0.max():.3f})", flush=True)
         for g in range(args.generations):
             gaits = np.clip(mu + sig * rng.standard_normal((pop, NPAR)), -1, 1)
             gaits[0] = mu
             res = evaluate(pool, gaits, args, n_obj)
-            score = np.where(res[:, :, 6] > 0, -1.0, (sign * res[:, :, col] / unit).clip(-2, 2)).mean(1)
+            score = scores(res)
             elite = np.argsort(-score)[:pop // 4]
             mu, sig = gaits[elite].mean(0), np.maximum(gaits[elite].std(0), 0.05)
             for p, r, s in zip(gaits, res, score):
