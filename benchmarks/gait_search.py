@@ -30,6 +30,20 @@ as -1 (``--init FILE``: start from the best gait of a log instead):
     python benchmarks/gait_search.py --skill translate --axis z- --refine z- --steps 64 --amplitude 0.6 \
         --no-randomize --limit 2 --generations 30 --out docs/runs/gait_search/translate_zm_refine.jsonl
 
+``--hold`` (with ``--refine``) scores what the rotate protocol counts: the gait stops for good once
+the object has turned past the success angle about the axis (the fingers hold their targets; read
+from the task's state) and the episode runs on to ``--steps`` (400: the protocol's); an episode
+scores 1 for a success (passed, never dropped), half its turn in success angles otherwise, -0.5 for
+a drop. With ``--init`` the first generation is the 16 logged gaits that turned the object furthest
+about the axis; the search goes on from the best of them. ``--select N`` re-runs the N best
+distinct gaits on ``--select-seeds`` new starts per object and logs their success rate: the gait
+that ``unicross eval --policy gait:LOG`` runs (:mod:`unicross.gaits`). The shipped rotate gaits:
+
+    python benchmarks/gait_search.py --skill rotate --axis x+ --refine x+ --hold \
+        --init docs/runs/gait_search/rotate_norand.jsonl.gz docs/runs/gait_search/rotate_one_finger_norand.jsonl.gz \
+        --steps 400 --amplitude 0.6 --no-randomize --limit 2 --generations 8 --sigma 0.2 --select 6 \
+        --out docs/runs/gait_search/rotate_x+_hold.jsonl
+
 Episodes run in two spawned worker processes, one env per object each.
 """
 from __future__ import annotations
@@ -45,24 +59,8 @@ import time
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-NPAR = 6 * 4 + 1
+from unicross.gaits import NPAR, gait_targets  # noqa: E402
 _ENVS = {}
-
-
-def gait_targets(p, t: int, q0):
-    """Finger targets of gait ``p`` ([25] in [-1, 1]) at control step ``t`` from the start command ``q0``."""
-    period = 6 + 30 * (p[24] + 1) / 2
-    q = q0.clone()
-    for f in range(4):
-        a_abd, a_mcp, a_dis, ph, loop, bias = (float(v) for v in p[6 * f: 6 * f + 6])
-        th = 2 * math.pi * t / period + math.pi * ph
-        j = 4 * f
-        q[j] += 0.3 * a_abd * math.sin(th)
-        q[j + 1] += 0.5 * a_mcp * math.sin(th) + 0.2 * bias
-        d = 0.5 * a_dis * math.sin(th + math.pi * loop) + 0.2 * bias
-        q[j + 2] += d
-        q[j + 3] += d
-    return q
 
 
 def _env(job):
@@ -85,7 +83,11 @@ def _env(job):
 
 
 def episode(job) -> list:
-    """[rotation x, y, z (rad), displacement x, y, z (m), dropped, steps] of one gait episode."""
+    """[rotation x, y, z (rad), displacement x, y, z (m), dropped, steps, exceeded] of one gait episode.
+
+    With ``job["hold"]`` = (component, sign, threshold) the gait stops for good once the motion about
+    or along that signed axis exceeds the threshold (the fingers hold their targets from then on) and
+    the episode runs on to ``steps``: the protocol's "exceeded, never dropped" (``exceeded`` = 1)."""
     import torch
     torch.set_num_threads(1)
     u = _env(job)
@@ -99,28 +101,57 @@ def episode(job) -> list:
     q0 = u.command[0, 6:].clone()
     x0 = u.cur_rel.x_oh[0].clone()
     rot = torch.zeros(3)
-    dropped, steps = False, 0
+    dropped, steps, exceeded = False, 0, False
     for t in range(job["steps"]):
         a = torch.zeros(1, u.action_scale.shape[0])
-        a[0, 6:] = ((gait_targets(p, t + 1, q0) - u.command[0, 6:]) / u.action_scale[6:]).clamp(-1, 1)
+        if not exceeded:
+            a[0, 6:] = ((gait_targets(p, t + 1, q0) - u.command[0, 6:]) / u.action_scale[6:]).clamp(-1, 1)
         _, _, term, trunc, _ = u.step(a)
         steps += 1
         if bool(term[0]) or bool(u.ever_dropped[0]):
             dropped = True
             break
         rot += u.obj_angvel_h[0] * u.control_dt
+        if job.get("hold") is not None:
+            comp, sign, thr = job["hold"]
+            motion = rot if comp < 3 else u.cur_rel.x_oh[0] - x0
+            exceeded |= bool(sign * motion[comp % 3] > thr)
         if bool(trunc[0]):
             break
-    return rot.tolist() + (u.cur_rel.x_oh[0] - x0).tolist() + [float(dropped), steps]
+    return rot.tolist() + (u.cur_rel.x_oh[0] - x0).tolist() + [float(dropped), steps, float(exceeded)]
 
 
-def evaluate(pool, gaits, args, n_obj, first: int = 0):
+def evaluate(pool, gaits, args, n_obj, first: int = 0, hold=None, seeds=None):
+    """[gaits, episodes, 9] of every gait on every object x start (``seeds``: the starts' indices,
+    default ``range(args.seeds)``)."""
     from unicross.seeding import trial_seed
+    seeds = list(range(args.seeds)) if seeds is None else list(seeds)
     jobs = [dict(p=p.tolist(), oi=oi, seed=trial_seed(0, oi, k), skill=args.skill, axis=args.axis,
                  objects=args.objects, limit=args.limit, randomize=not args.no_randomize, steps=args.steps,
-                 amplitude=args.amplitude, finger=(first + i) % 4 if args.one_finger else None)
-            for i, p in enumerate(gaits) for oi in range(n_obj) for k in range(args.seeds)]
-    return np.array(pool.map(episode, jobs, chunksize=1)).reshape(len(gaits), n_obj * args.seeds, 8)
+                 amplitude=args.amplitude, finger=(first + i) % 4 if args.one_finger else None, hold=hold)
+            for i, p in enumerate(gaits) for oi in range(n_obj) for k in seeds]
+    return np.array(pool.map(episode, jobs, chunksize=1)).reshape(len(gaits), n_obj * len(seeds), 9)
+
+
+def init_gaits(paths, amplitude: float):
+    """(gaits [n, 25] as this search's parameters, their logged results [n, episodes, 8]) of the rows of
+    earlier logs: a one-finger row gets its still fingers' amplitudes zeroed, and every row is rescaled
+    from its log's ``--amplitude`` to ``amplitude`` (clipped to [-1, 1]), so it moves the fingers as logged."""
+    from unicross.gaits import read_log
+    ps, rs = [], []
+    for path in paths:
+        for row in read_log(path):
+            p = np.array(row["p"], dtype=float)
+            finger = row.get("finger")
+            if finger is not None:
+                for f in range(4):
+                    if f != finger:
+                        p[6 * f: 6 * f + 3] = 0.0
+            p[:24] = (p[:24] * row.get("meta", {}).get("amplitude", 1.0) / amplitude).clip(-1, 1)
+            ps.append(p)
+            rs.append(np.array(row["r"])[:, :8])
+    n_ep = min(r.shape[0] for r in rs)
+    return np.array(ps), np.array([r[:n_ep] for r in rs])
 
 
 def summary(paths):
@@ -156,9 +187,19 @@ def main():
     ap.add_argument("--one-finger", action="store_true",
                     help="gait i moves finger i mod 4 only (index, middle, ring, thumb); the others keep their bias")
     ap.add_argument("--no-randomize", action="store_true", help="the evaluation's conditions (default: training's)")
-    ap.add_argument("--init", default=None, help="--refine: start from the best gait of this log (same score)")
+    ap.add_argument("--init", nargs="+", default=None,
+                    help="--refine: start from the best gait of these logs (same score); with --hold the first "
+                         "generation is the 16 logged gaits that moved the object furthest")
     ap.add_argument("--refine", default=None, help="cross-entropy search for motion along / about this axis (x+ ... z-)")
     ap.add_argument("--generations", type=int, default=10)
+    ap.add_argument("--sigma", type=float, default=0.35, help="--refine: the search's starting spread")
+    ap.add_argument("--select", type=int, default=0,
+                    help="--refine --hold: at the end, evaluate the N best distinct gaits on --select-seeds new starts "
+                         "per object and log their success (what `--policy gait:LOG` picks)")
+    ap.add_argument("--select-seeds", type=int, default=4)
+    ap.add_argument("--hold", action="store_true",
+                    help="--refine: the gait stops once the motion exceeds the success threshold, the fingers hold "
+                         "to --steps; score = the protocol's success (exceeded, never dropped)")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--out", default=None)
     ap.add_argument("--summary", nargs="+", default=None)
@@ -194,28 +235,62 @@ def main():
         # accumulated rotation (columns 0-2) in success angles, or displacement (3-5) in success distances
         col, unit = (comp, sc["rotate_angle"]) if args.skill == "rotate" else (3 + comp, sc["translate_dist"])
 
+        hold = (col, sign, unit) if args.hold else None
+
         def scores(res):  # per gait: mean over its episodes, a drop -1
             return np.where(res[:, :, 6] > 0, -1.0, (sign * res[:, :, col] / unit).clip(-2, 2)).mean(1)
 
-        mu, sig, pop = np.zeros(NPAR), np.full(NPAR, 0.35), 16
-        if args.init:
-            rows = [json.loads(line) for line in (gzip.open if args.init.endswith(".gz") else open)(args.init, "rt")]
-            s0 = scores(np.array([r["r"] for r in rows]))
-            mu = np.array(rows[int(np.argmax(s0))]["p"])
+        def hold_scores(res):  # --hold: a success 1 (exceeded, never dropped), else half the motion, a drop -0.5
+            dropped, ok = res[:, :, 6] > 0, res[:, :, 8] > 0
+            partial = 0.5 * (sign * res[:, :, col] / unit).clip(-1, 1)
+            return np.where(dropped, -0.5, np.where(ok, 1.0, partial)).mean(1)
+
+        mu, sig, pop = np.zeros(NPAR), np.full(NPAR, args.sigma), 16
+        first = None
+        if args.init and hold:  # the first generation: the logged gaits that moved the object furthest,
+            ps, rs = init_gaits(args.init, args.amplitude)  # drops ignored (holding might have prevented them)
+            reach = (sign * rs[:, :, col] / unit).clip(-1, 1).mean(1)
+            first = ps[np.argsort(-reach)[:pop]]
+            print(f"first generation: the {pop} gaits of {len(ps)} in {args.init} that moved the object furthest "
+                  f"(mean reach {np.sort(reach)[-pop:].mean():.2f} success units)", flush=True)
+        elif args.init:
+            ps, rs = init_gaits(args.init, args.amplitude)
+            s0 = scores(rs)
+            mu = ps[int(np.argmax(s0))]
             print(f"starting from the best gait of {args.init} (score {s0.max():.3f})", flush=True)
         for g in range(args.generations):
             gaits = np.clip(mu + sig * rng.standard_normal((pop, NPAR)), -1, 1)
             gaits[0] = mu
-            res = evaluate(pool, gaits, args, n_obj)
-            score = scores(res)
+            if g == 0 and first is not None:
+                gaits = first
+            res = evaluate(pool, gaits, args, n_obj, hold=hold)
+            score = hold_scores(res) if hold else scores(res)
             elite = np.argsort(-score)[:pop // 4]
             mu, sig = gaits[elite].mean(0), np.maximum(gaits[elite].std(0), 0.05)
+            if g == 0 and first is not None:  # unrelated gaits: their mean is none of them; go on from the best
+                mu, sig = gaits[elite[0]], np.full(NPAR, args.sigma)
             for p, r, s in zip(gaits, res, score):
                 log.write(json.dumps(dict(meta=meta, generation=g, p=p.tolist(), r=r.tolist(), score=float(s))) + "\n")
             log.flush()
             print(f"generation {g}: best score {score.max():.3f} (the mean gait {score[0]:.3f}), "
                   f"its {'rotation' if args.skill == 'rotate' else 'displacement'} "
-                  f"{np.round(res[elite[0], :, col], 3).tolist()}, dropped {res[elite[0], :, 6].mean():.0%}", flush=True)
+                  f"{np.round(res[elite[0], :, col], 3).tolist()}, dropped {res[elite[0], :, 6].mean():.0%}"
+                  + (f", succeeded {(res[elite[0], :, 8] * (1 - res[elite[0], :, 6])).mean():.0%}" if hold else ""),
+                  flush=True)
+        if hold and args.select:  # the best distinct gaits on new starts: the choice of gait is not the luck of 8 episodes
+            rows = [json.loads(line) for line in open(args.out)]
+            rows = [r for r in rows if "score" in r and not r.get("selection")
+                    and r.get("meta", {}).get("refine") == args.refine]
+            rows = sorted({tuple(r["p"]): r for r in rows}.values(), key=lambda r: -r["score"])[:args.select]
+            cand = np.array([r["p"] for r in rows])
+            res = evaluate(pool, cand, args, n_obj, hold=hold, seeds=range(args.seeds, args.seeds + args.select_seeds))
+            ok = ((res[:, :, 8] > 0) & (res[:, :, 6] == 0)).mean(1)
+            for p, r, row, s in zip(cand, res, rows, ok):
+                log.write(json.dumps(dict(meta=meta, selection=True, p=p.tolist(), r=r.tolist(), score=row["score"],
+                                          success=float(s))) + "\n")
+            log.flush()
+            print(f"selection on {res.shape[1]} new starts: success {np.round(ok, 3).tolist()} "
+                  f"(search scores {[round(r['score'], 3) for r in rows]})", flush=True)
 
 
 if __name__ == "__main__":

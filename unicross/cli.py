@@ -525,7 +525,8 @@ def main(argv=None) -> int:
     s = sub.add_parser("eval", help="run the paper's evaluation protocols; writes JSON (every trial) and a table")
     s.add_argument("--policy", required=True,
                    help="checkpoint path, or zero | random | scripted-grasp | scripted-relocate | reference[@FRACTION] "
-                        "(the physical reference: translate z+)")
+                        "(the physical reference: translate z+) | gait:LOG or gait:allegro/rotate_y- (the best finger gait "
+                        "of a benchmarks/gait_search.py log, or a shipped one, run until the mode is done, then holding)")
     s.add_argument("--protocol", default="all", help="grasp, relocate, rotate, translate (comma list) or all")
     s.add_argument("--objects", default="test", help="object set: train | test | unseen (| -wrappable/-elongated | mesh:<file>)")
     s.add_argument("--limit", type=positive, default=None, help="first N objects per (category, type) group")

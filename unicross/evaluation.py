@@ -22,7 +22,9 @@ The protocol settings (trials per object, disturbance scale, PE/AE window) are i
 
 Policies: a checkpoint path, ``zero`` (no action), ``random``, ``scripted-relocate`` (the
 paper's naive relocation baseline) or ``reference[@FRACTION]`` (the mode's physical reference,
-where one is known: translate z+ opens the fingers). Same seed and policy give identical results.
+where one is known: translate z+ opens the fingers) or ``gait:LOG`` / ``gait:<hand>/<mode>`` (the best finger
+gait of a ``benchmarks/gait_search.py`` log or a shipped one, run until the mode's threshold is
+passed, then holding: :mod:`unicross.gaits`). Same seed and policy give identical results.
 """
 from __future__ import annotations
 
@@ -151,6 +153,14 @@ def resolve_policy(spec: str, hand: str, seed: int = 0):
         return scripted_relocate_policy, dict(kind="scripted-relocate")
     if spec == "scripted-grasp":
         return make_scripted_grasp_policy(), dict(kind="scripted-grasp")
+    if spec.startswith("gait:"):
+        from unicross.gaits import make_gait_policy
+        path = spec[len("gait:"):]
+        if hand != "allegro":
+            raise ValueError(f"policy {spec!r}: gaits are written for Allegro's four fingers, not hand {hand!r}")
+        policy = make_gait_policy(path)  # a missing file fails here, before any simulation
+        return policy, dict(kind="gait", path=path, gait=policy.gait_row["p"],
+                            meta=policy.gait_row.get("meta", {}))
     from unicross.rl.policy_io import act, load_policy
     from unicross.robots.hand import load_hand
     policy, ck = load_policy(spec)

@@ -1,0 +1,83 @@
+"""Scripted finger gaits (unicross.gaits): the gait's targets, the choice of gait from a search log,
+and the policy's stop once the mode's threshold is passed; on a stand-in env, no simulator."""
+import json
+import math
+from types import SimpleNamespace
+
+import pytest
+import torch
+
+from unicross import formulation as F
+from unicross.config import load_config
+from unicross.gaits import NPAR, best_gait, gait_targets, make_gait_policy
+
+pytestmark = pytest.mark.unit
+
+
+def test_zero_gait_keeps_the_start_command_and_shapes_broadcast():
+    q0 = torch.randn(3, 16)
+    assert torch.equal(gait_targets([0.0] * NPAR, 7, q0), q0)
+    p = torch.rand(NPAR) * 2 - 1
+    one = gait_targets(p, 5, q0[0])
+    assert one.shape == (16,) and torch.allclose(gait_targets(p, 5, q0)[0], one)
+    period = 6 + 30 * (float(p[24]) + 1) / 2
+    assert torch.allclose(gait_targets(p, 5, q0), gait_targets(p, 5 + period, q0), atol=1e-5)  # periodic
+
+
+def _write(path, rows):
+    path.write_text("".join(json.dumps(r) + "\n" for r in rows))
+
+
+def test_best_gait_prefers_the_selection_and_applies_the_amplitude(tmp_path):
+    meta = dict(amplitude=0.5)
+    rows = [dict(meta=meta, p=[1.0] * NPAR, score=0.9),
+            dict(meta=meta, p=[0.2] * NPAR, score=0.1),
+            dict(meta=meta, selection=True, p=[0.2] * NPAR, score=0.1, success=0.7),
+            dict(meta=meta, selection=True, p=[1.0] * NPAR, score=0.9, success=0.4)]
+    _write(tmp_path / "log.jsonl", rows)
+    p, row = best_gait(str(tmp_path / "log.jsonl"))
+    assert row["success"] == 0.7
+    assert torch.allclose(p[:24], torch.full((24,), 0.1)) and float(p[24]) == pytest.approx(0.2)
+    _write(tmp_path / "search.jsonl", rows[:2])
+    assert best_gait(str(tmp_path / "search.jsonl"))[1]["score"] == 0.9
+    _write(tmp_path / "random.jsonl", [dict(meta=meta, p=[0.0] * NPAR, r=[[0.0] * 8])])
+    with pytest.raises(ValueError, match="not a gait search log"):
+        best_gait(str(tmp_path / "random.jsonl"))
+
+
+def _stand_in_env(n: int, mode: str, axis):
+    return SimpleNamespace(hand_spec=SimpleNamespace(dof=22, name="allegro"), num_envs=n, device="cpu",
+                           elapsed_steps=torch.zeros(n, dtype=torch.int32), command=torch.zeros(n, 22),
+                           action_scale=torch.full((22,), 0.1), mode=torch.full((n,), F.MODES.index(mode)),
+                           cfg=load_config("task"), axis=torch.tensor(axis, dtype=torch.float32).expand(n, 3),
+                           obj_angvel_h=torch.zeros(n, 3), obj_vel_h=torch.zeros(n, 3), control_dt=0.05)
+
+
+def test_the_policy_runs_the_gait_until_the_object_has_turned_past_the_angle_then_holds(tmp_path):
+    g = torch.Generator().manual_seed(0)
+    _write(tmp_path / "log.jsonl", [dict(meta=dict(amplitude=1.0), p=(torch.rand(NPAR, generator=g) * 2 - 1).tolist(),
+                                         score=1.0)])
+    policy = make_gait_policy(str(tmp_path / "log.jsonl"))
+    u = _stand_in_env(2, "rotate_y-", [0.0, -1.0, 0.0])
+    angle = u.cfg["success"]["rotate_angle"]
+    steps_to_pass = math.floor(angle / 0.05) + 1  # 1 rad/s about -y (env 0), none for env 1
+    for t in range(steps_to_pass + 3):
+        u.elapsed_steps[:] = t
+        a = policy(None, u)
+        assert a.shape == (2, 22) and torch.all(a[:, :6] == 0)  # the wrist holds still
+        moving = a[:, 6:].abs().sum(-1) > 0
+        assert bool(moving[1])  # never turned: the gait goes on
+        assert bool(moving[0]) == (t < steps_to_pass)
+        u.command[:, 6:] += a[:, 6:] * u.action_scale[6:]
+        u.obj_angvel_h[0] = torch.tensor([0.0, -1.0, 0.0])
+    u.elapsed_steps[:] = 0  # a reset starts the gait again
+    assert bool((policy(None, u)[0, 6:].abs().sum() > 0))
+
+
+def test_gait_policies_refuse_other_hands(tmp_path):
+    from unicross.evaluation import resolve_policy
+    _write(tmp_path / "log.jsonl", [dict(meta={}, p=[0.0] * NPAR, score=0.0)])
+    with pytest.raises(ValueError, match="Allegro"):
+        resolve_policy(f"gait:{tmp_path / 'log.jsonl'}", "shadow")
+    policy, desc = resolve_policy(f"gait:{tmp_path / 'log.jsonl'}", "allegro")
+    assert desc["kind"] == "gait"

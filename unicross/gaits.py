@@ -1,0 +1,121 @@
+"""Open-loop periodic finger gaits, and the scripted in-hand policy that runs one until its mode is done.
+
+A gait is 25 numbers in [-1, 1] (6 per finger and the period); finger f's joints (abduction, MCP,
+PIP = DIP) follow ``q0 + bias + amplitude * sin(2 pi t / T + phase)`` around the start command q0,
+with the distal joints shifted by a loop phase (a closed path in joint space), T in 6..36 control
+steps; the wrist holds still. ``benchmarks/gait_search.py`` samples gaits and refines them with a
+cross-entropy search; its logs (JSON lines with ``p``, ``meta`` and, for a search, ``score``) are
+what :func:`best_gait` reads.
+
+:func:`make_gait_policy` runs a gait until the object's accumulated motion about (rotate) or along
+(translate) the env's own axis exceeds the mode's success threshold, then holds the fingers where
+they are (the protocol counts a success only if the object is never dropped afterwards). The stop
+reads the task's privileged state (the object's velocity in the hand frame), as the scripted grasp
+does: a scripted reference, not a learned policy. Four fingers of four joints each (Allegro).
+"""
+from __future__ import annotations
+
+import gzip
+import json
+import math
+from pathlib import Path
+from typing import Tuple
+
+import torch
+
+NPAR = 6 * 4 + 1
+
+
+def gait_targets(p, t: int, q0: torch.Tensor) -> torch.Tensor:
+    """Finger targets [..., 16] of gait ``p`` ([25] in [-1, 1]) at control step ``t`` around ``q0`` [..., 16]."""
+    period = 6 + 30 * (float(p[24]) + 1) / 2
+    q = q0.clone()
+    for f in range(4):
+        a_abd, a_mcp, a_dis, ph, loop, bias = (float(v) for v in p[6 * f: 6 * f + 6])
+        th = 2 * math.pi * t / period + math.pi * ph
+        j = 4 * f
+        q[..., j] += 0.3 * a_abd * math.sin(th)
+        q[..., j + 1] += 0.5 * a_mcp * math.sin(th) + 0.2 * bias
+        d = 0.5 * a_dis * math.sin(th + math.pi * loop) + 0.2 * bias
+        q[..., j + 2] += d
+        q[..., j + 3] += d
+    return q
+
+
+SHIPPED_DIR = Path(__file__).resolve().parent / "checkpoints"
+
+
+def resolve_gait(spec: str) -> str:
+    """A gait log path, or the shorthand ``<hand>/<mode>`` of a shipped gait
+    (``unicross/checkpoints/<hand>/gaits/<mode>.json``, e.g. ``allegro/rotate_y-``)."""
+    if Path(spec).exists() or spec.endswith((".json", ".jsonl", ".gz")):
+        if not Path(spec).exists():
+            raise FileNotFoundError(f"gait log not found: {spec}")
+        return spec
+    hand, _, mode = spec.partition("/")
+    shipped = SHIPPED_DIR / hand / "gaits" / f"{mode}.json"
+    if not shipped.exists():
+        have = sorted(f"{p.parent.parent.name}/{p.stem}" for p in SHIPPED_DIR.glob("*/gaits/*.json"))
+        raise FileNotFoundError(f"gait not found: {spec} (shipped gaits: {have})")
+    return str(shipped)
+
+
+def shipped_gaits(hand: str) -> dict:
+    """Mode -> ``<hand>/<mode>`` of every gait shipped for ``hand``."""
+    return {p.stem: f"{hand}/{p.stem}" for p in sorted((SHIPPED_DIR / hand / "gaits").glob("*.json"))}
+
+
+def read_log(path: str) -> list:
+    """The rows of a gait log (``.jsonl`` or ``.jsonl.gz``), or the one row of a shipped gait (``.json``)."""
+    if path.endswith(".json"):
+        with open(path) as f:
+            return [json.load(f)]
+    with (gzip.open(path, "rt") if path.endswith(".gz") else open(path)) as f:
+        return [json.loads(line) for line in f if line.strip()]
+
+
+def best_gait(path: str) -> Tuple[torch.Tensor, dict]:
+    """(gait [25] with the log's amplitude applied to its amplitudes and bias, the row) of the best
+    row of a gait log: the highest ``success`` of its selection rows (``--select``), else the
+    highest search ``score``."""
+    rows = read_log(path)
+    key = "success" if any("success" in r for r in rows) else "score"
+    rows = [r for r in rows if key in r]
+    if not rows:
+        raise ValueError(f"{path}: not a gait search log (no row with a 'score' or 'success')")
+    row = max(rows, key=lambda r: r[key])
+    p = torch.tensor(row["p"], dtype=torch.float32)
+    p[:24] *= float(row.get("meta", {}).get("amplitude", 1.0))
+    return p, row
+
+
+def make_gait_policy(spec: str):
+    """The scripted in-hand policy of the best gait in ``spec`` (a log, or a shipped gait's
+    ``<hand>/<mode>``; see the module docstring)."""
+    from unicross import formulation as F
+    p, row = best_gait(resolve_gait(spec))
+    state = {}
+
+    def policy(obs, u):
+        if u.hand_spec.dof - 6 != 16:
+            raise ValueError(f"gait policy: written for four fingers of four joints (Allegro), "
+                             f"hand {u.hand_spec.name!r} has {u.hand_spec.dof - 6} finger joints")
+        t = int(u.elapsed_steps[0])
+        if t == 0 or state.get("env") is not u:
+            is_rot = torch.tensor([F.mode_skill(F.MODES[int(m)]) == "rotate" for m in u.mode.tolist()],
+                                  device=u.device)
+            sc = u.cfg["success"]
+            state.update(env=u, q0=u.command[:, 6:].clone(), is_rot=is_rot,
+                         threshold=torch.where(is_rot, sc["rotate_angle"], sc["translate_dist"]),
+                         motion=torch.zeros(u.num_envs, device=u.device),
+                         done=torch.zeros(u.num_envs, dtype=torch.bool, device=u.device))
+        else:  # the motion of the step just taken, about / along the env's axis
+            vel = torch.where(state["is_rot"][:, None], u.obj_angvel_h, u.obj_vel_h)
+            state["motion"] += (vel * u.axis).sum(-1) * u.control_dt
+        state["done"] |= state["motion"] > state["threshold"]
+        a = torch.zeros(u.num_envs, u.hand_spec.dof, device=u.device)
+        step = ((gait_targets(p, t + 1, state["q0"]) - u.command[:, 6:]) / u.action_scale[6:]).clamp(-1, 1)
+        a[:, 6:] = torch.where(state["done"][:, None], torch.zeros_like(step), step)
+        return a
+    policy.gait_row = row
+    return policy
