@@ -76,8 +76,18 @@ def test_the_policy_runs_the_gait_until_the_object_has_turned_past_the_angle_the
 
 def test_gait_policies_refuse_other_hands(tmp_path):
     from unicross.evaluation import resolve_policy
-    _write(tmp_path / "log.jsonl", [dict(meta={}, p=[0.0] * NPAR, score=0.0)])
+    _write(tmp_path / "log.jsonl", [dict(meta=dict(skill="rotate", refine="z+"), p=[0.0] * NPAR, score=0.0)])
     with pytest.raises(ValueError, match="Allegro"):
         resolve_policy(f"gait:{tmp_path / 'log.jsonl'}", "shadow")
     policy, desc = resolve_policy(f"gait:{tmp_path / 'log.jsonl'}", "allegro")
-    assert desc["kind"] == "gait"
+    assert desc["kind"] == "gait" and desc["mode"] == "rotate_z+"
+
+
+def test_a_gait_is_evaluated_on_its_own_mode_only(tmp_path, capsys):
+    from unicross.cli import main
+    _write(tmp_path / "log.jsonl", [dict(meta=dict(skill="rotate", refine="y-"), p=[0.0] * NPAR, score=0.0)])
+    for extra in ([], ["--axis", "x+"], ["--axis", "y-,x+"]):
+        assert main(["eval", "--policy", f"gait:{tmp_path / 'log.jsonl'}", "--protocol", "rotate", *extra,
+                     "--out", str(tmp_path / "ev")]) != 0
+        assert "is a gait for rotate_y-: evaluate it with --protocol rotate --axis y-" in capsys.readouterr().err
+    assert not (tmp_path / "ev").exists()

@@ -22,9 +22,19 @@ def test_report_paper_one_trial(tmp_path):
     for mode in ("grasp", "relocate"):
         if mode in ships:  # one trial per test object
             assert f"| {mode} | allegro/{mode} | " in text and f"(n={n_test})" in text
+    from unicross.gaits import make_gait_policy, shipped_gaits
+    gaits = shipped_gaits("allegro")
     for mode in ("rotate_x+", "translate_z-"):
         if mode not in ships:
-            assert f"| {mode} | expert not shipped | -- |" in text
+            extra = " (a scripted gait: see below)" if mode in gaits else ""
+            assert f"| {mode} | expert not shipped{extra} | -- |" in text
+    if gaits:  # each shipped gait has its row, and a row is the evaluation of that gait
+        assert "## Scripted finger gaits (not PPO experts), held-out test objects" in text
+        assert all(f"| {mode} | gait:{spec} | " in text for mode, spec in gaits.items())
+        mode = next(iter(gaits))
+        trials = E.run_protocol("rotate", make_gait_policy(gaits[mode]), get_object_set("test", limit=1),
+                                trials_per_object=1, seed=0, progress=False, axes=[mode.split("_")[1]])
+        assert f"| {mode} | gait:{gaits[mode]} | {_cell(E.summarize('rotate', trials), 'rotate')} |" in text
     # a cell is the evaluation itself: the zero-action relocation row equals an independent run
     trials = E.run_protocol("relocate", E.zero_policy, get_object_set("test", limit=1), trials_per_object=1,
                             seed=0, progress=False)

@@ -321,6 +321,11 @@ def _cmd_eval(args) -> int:
                              f"{sorted(PHYSICAL_REFERENCES)} (e.g. --protocol translate --axis z+)")
     objs = get_object_set(args.objects, limit=args.limit)
     _, desc = E.resolve_policy(args.policy, args.hand, seed=args.seed)  # checks the checkpoint before simulating
+    if desc["kind"] == "gait":  # a gait does one mode: it is evaluated on that mode only
+        skill, _, axis = desc["mode"].partition("_")
+        if protocols != [skill] or axes != [axis]:
+            raise ValueError(f"--policy {args.policy} is a gait for {desc['mode']}: evaluate it with "
+                             f"--protocol {skill} --axis {axis}")
     ablation = desc.get("ablation")
     if args.ablation:
         bad = [f for f in args.ablation if f not in ABLATIONS]

@@ -159,7 +159,8 @@ def resolve_policy(spec: str, hand: str, seed: int = 0):
         if hand != "allegro":
             raise ValueError(f"policy {spec!r}: gaits are written for Allegro's four fingers, not hand {hand!r}")
         policy = make_gait_policy(path)  # a missing file fails here, before any simulation
-        return policy, dict(kind="gait", path=path, gait=policy.gait_row["p"],
+        from unicross.gaits import gait_mode
+        return policy, dict(kind="gait", path=path, mode=gait_mode(policy.gait_row), gait=policy.gait_row["p"],
                             meta=policy.gait_row.get("meta", {}))
     from unicross.rl.policy_io import act, load_policy
     from unicross.robots.hand import load_hand

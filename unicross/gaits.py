@@ -89,6 +89,17 @@ def best_gait(path: str) -> Tuple[torch.Tensor, dict]:
     return p, row
 
 
+def gait_mode(row: dict) -> str:
+    """The mode a gait was searched for (e.g. ``rotate_y-``): a shipped gait's ``mode``, else its
+    search's ``--skill`` and ``--refine`` axis."""
+    if "mode" in row:
+        return row["mode"]
+    meta = row.get("meta", {})
+    if not meta.get("refine"):
+        raise ValueError("a gait log without --refine names no mode")
+    return f"{meta.get('skill', 'rotate')}_{meta['refine']}"
+
+
 def make_gait_policy(spec: str):
     """The scripted in-hand policy of the best gait in ``spec`` (a log, or a shipped gait's
     ``<hand>/<mode>``; see the module docstring)."""
