@@ -23,7 +23,10 @@ from typing import Tuple
 
 import torch
 
+from unicross import formulation as F
+
 NPAR = 6 * 4 + 1
+ROTATE_MODES = torch.tensor([F.mode_skill(m) == "rotate" for m in F.MODES])  # [modes]: rotation (else translation)
 
 
 def gait_targets(p, t: int, q0: torch.Tensor) -> torch.Tensor:
@@ -103,7 +106,6 @@ def gait_mode(row: dict) -> str:
 def make_gait_policy(spec: str):
     """The scripted in-hand policy of the best gait in ``spec`` (a log, or a shipped gait's
     ``<hand>/<mode>``; see the module docstring)."""
-    from unicross import formulation as F
     p, row = best_gait(resolve_gait(spec))
     state = {}
 
@@ -113,8 +115,7 @@ def make_gait_policy(spec: str):
                              f"hand {u.hand_spec.name!r} has {u.hand_spec.dof - 6} finger joints")
         t = int(u.elapsed_steps[0])
         if t == 0 or state.get("env") is not u:
-            is_rot = torch.tensor([F.mode_skill(F.MODES[int(m)]) == "rotate" for m in u.mode.tolist()],
-                                  device=u.device)
+            is_rot = ROTATE_MODES.to(u.device)[u.mode.long()]
             sc = u.cfg["success"]
             state.update(env=u, q0=u.command[:, 6:].clone(), is_rot=is_rot,
                          threshold=torch.where(is_rot, sc["rotate_angle"], sc["translate_dist"]),

@@ -168,7 +168,7 @@ class PaperReport:
                 "An open-loop finger gait per mode, found by a cross-entropy search on training objects "
                 "(`benchmarks/gait_search.py --hold`), run until the object has turned past the success angle "
                 "(read from the task's state), then holding still: a scripted reference, not a learned policy. "
-                "Rot. counts the turn up to the stop (the paper's policies keep turning for 400 steps).")
+                "Rot. stays near the success angle by design (the paper's policies keep turning for 400 steps).")
             rot = [self.summaries.get((m, f"gait:{s}", objects, False)) for m, s in self.gaits.items()
                    if skill_of_mode(m).name == "rotate"]
             rot = [r for r in rot if r]
@@ -176,7 +176,9 @@ class PaperReport:
                 k, n = sum(r["successes"] for r in rot), sum(r["n"] for r in rot)
                 lo, hi = wilson_interval(k, n)
                 lines += [f"Rotate, pooled over the {len(rot)} axes with a gait (of 6): "
-                          f"{100 * k / n:.1f} [{100 * lo:.1f}-{100 * hi:.1f}] (n={n}).", ""]
+                          f"{100 * k / n:.1f} [{100 * lo:.1f}-{100 * hi:.1f}] (n={n}); the issue's target for "
+                          f"the experts: >= 50% averaged over the six axes (paper {PAPER[setting]['rotate'][0]:.1f}).",
+                          ""]
         return lines
 
     def _long_horizon(self) -> List[str]:
