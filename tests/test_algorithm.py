@@ -77,3 +77,22 @@ def test_adaptive_rate_ignores_the_kl_of_the_updates_first_step():
     out = algo.update(bandit_batch(algo, torch.Generator().manual_seed(3)))
     assert out["minibatch_steps"] == 5
     assert out["lr"] == pytest.approx(1.0e-5 * 1.5 ** 4)
+
+
+def test_critic_warmup_leaves_the_actor_alone_then_hands_over():
+    """``optim.critic_warmup``: the first N updates move the critic only (the actor's weights and
+    the rate stay); the update after them moves the actor too; the count survives a state round trip."""
+    algo = make_algo(critic_warmup=2)
+    g = torch.Generator().manual_seed(4)
+    actor0 = [p.detach().clone() for p in algo.actor.parameters()]
+    critic0 = [p.detach().clone() for p in algo.value.critic.parameters()]
+    for _ in range(2):
+        out = algo.update(bandit_batch(algo, g))
+        assert out["critic_only"] == 1.0 and out["lr"] == algo.cfg["optim"]["lr"]
+    assert all(torch.equal(a, b) for a, b in zip(actor0, algo.actor.parameters()))
+    assert not all(torch.equal(a, b) for a, b in zip(critic0, algo.value.critic.parameters()))
+    other = make_algo(critic_warmup=2)
+    other.load_state_dict(algo.state_dict())
+    assert other.updates == 2
+    assert algo.update(bandit_batch(algo, g))["critic_only"] == 0.0
+    assert not all(torch.equal(a, b) for a, b in zip(actor0, algo.actor.parameters()))

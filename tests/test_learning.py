@@ -1,6 +1,7 @@
 """What learning needs from the tasks and the trainer: an audited reward, bounded and finite
 signals, varied and reproducible episodes, a PPO that starts near the zero action, and the
 shipped grasp expert."""
+import math
 import gymnasium as gym
 import pytest
 import torch
@@ -26,6 +27,16 @@ def test_in_hand_audits_rank_the_successful_reference_first(skill, axis, referen
     assert rows[0].behaviour == reference and rows[0].success > 0
     assert all(r.success <= rows[0].success for r in rows[1:])
     assert all(r.min_total > -1e3 for r in rows)  # bounded (discounted, scaled) even for random actions
+
+
+def test_rotate_audit_pays_a_successful_gait_more_than_holding_still():
+    """With our coefficients (the rotate success bonus), every episode in which the shipped y- gait
+    turns the object past the success angle earns more than any zero-action episode (without the
+    bonus, they earned less: configs/reward.yaml)."""
+    rows = {r.behaviour: r for r in audit("rotate", "y-", limit=2, seeds=3, progress=False, only=["gait", "zero"])}
+    won = [x for x, s in zip(rows["gait"].returns, rows["gait"].successes) if s]
+    assert won, "the gait succeeded in none of these episodes (it did in 3 of 12 when this test was written)"
+    assert min(won) > max(rows["zero"].returns)
 
 
 def test_relocate_audit_ranks_following_the_target_first():
@@ -235,4 +246,28 @@ def test_init_reference_starts_the_mean_at_the_physical_reference(tmp_path):
     finally:
         t.close()
     with pytest.raises(ValueError, match="no physical reference"):
+        PPOTrainer(tmp_path / "rot", "rotate", "x+", overrides=over, progress=False)
+
+
+def test_init_policy_starts_the_actor_from_a_policy_checkpoint(tmp_path):
+    """``model.init_policy``: the untrained actor acts as the named policy (weights and observation
+    statistics) with the configured exploration noise; a policy of another mode is refused before
+    any simulation."""
+    from unicross.rl.policy_io import load_policy, resolve_checkpoint
+    from unicross.rl.ppo import PPOTrainer
+    shipped = str(resolve_checkpoint("allegro/translate_z+"))
+    over = dict(env=dict(num_envs=1, object_limit=1), collector=dict(total_frames=16, horizon=16),
+                model=dict(init_policy=shipped, init_log_std=-2.0), logging=dict(eval_trials=0, final_eval_trials=0))
+    t = PPOTrainer(tmp_path / "tr", "translate", "z+", overrides=over, progress=False)
+    try:
+        ref, ck = load_policy(shipped)
+        g = torch.Generator().manual_seed(0)
+        x = [torch.randn(4, ck["obs_dims"][k], generator=g) for k in ("hand", "object", "goal")]
+        want, _ = ref.module[0].module(*x)
+        got, scale = t.algo.actor(*x)
+        torch.testing.assert_close(got, want)
+        torch.testing.assert_close(scale[0], torch.full_like(scale[0], math.exp(-2.0)))
+    finally:
+        t.close()
+    with pytest.raises(ValueError, match="this run trains"):
         PPOTrainer(tmp_path / "rot", "rotate", "x+", overrides=over, progress=False)

@@ -35,7 +35,7 @@ and more for every step on the way there (:func:`ascent`: the same sweep at a fr
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Callable, Dict, List, Optional
 
 import gymnasium as gym
@@ -193,9 +193,19 @@ def first_dip(rows: List["AuditRow"]) -> Optional[str]:
     return next((b.behaviour for a, b in zip(rows, rows[1:]) if b.total < a.total), None)
 
 
-def behaviours(skill: str, seed: int = 0) -> Dict[str, Callable]:
+def _gait(spec: str):
+    """The scripted finger gait ``spec`` (:mod:`unicross.gaits`), run until its mode is done, then holding."""
+    def make(u):
+        from unicross.gaits import make_gait_policy
+        policy = make_gait_policy(spec)
+        return lambda: policy(None, u)
+    return make
+
+
+def behaviours(skill: str, seed: int = 0, axis: Optional[str] = None, hand: str = "allegro") -> Dict[str, Callable]:
     """name -> factory(u) -> act() for the reference behaviours of ``skill``; the first is the
-    successful reference."""
+    successful reference. With ``axis``, a mode with a shipped scripted gait (:mod:`unicross.gaits`)
+    also lists it as ``gait``."""
     common = dict(zero=_zero, random=_random_factory(seed))
     if skill == "grasp":
         return dict(scripted=_grasp_script(lift=True, close=True, descend=True),
@@ -206,8 +216,10 @@ def behaviours(skill: str, seed: int = 0) -> Dict[str, Callable]:
         return dict(follow=_zero, follow_tight=_follow_relocate, naive=_naive_relocate, stay=_stay,
                     random=common["random"])
     if skill in ("rotate", "translate"):
-        return dict(oracle=_oracle, zero=common["zero"], open=_finger_sweep(-0.02), close=_finger_sweep(0.02),
-                    random=common["random"])
+        from unicross.gaits import shipped_gaits
+        gait = shipped_gaits(hand).get(f"{skill}_{axis}") if axis else None
+        return dict(oracle=_oracle, **(dict(gait=_gait(gait)) if gait else {}), zero=common["zero"],
+                    open=_finger_sweep(-0.02), close=_finger_sweep(0.02), random=common["random"])
     raise ValueError(f"unknown skill {skill!r}; valid: grasp, relocate, rotate, translate")
 
 
@@ -221,6 +233,8 @@ class AuditRow:
     terms: Dict[str, float]     # mean discounted, scaled return per term
     undiscounted: float         # mean raw (unscaled, undiscounted) return
     min_total: float            # worst episode (discounted, scaled)
+    returns: List[float] = field(default_factory=list)    # every episode's total (discounted, scaled)
+    successes: List[float] = field(default_factory=list)  # every episode's success at its end (0 or 1)
 
 
 def audit(skill: str = "grasp", axis: Optional[str] = None, objects: Optional[str] = None, limit: int = 2,
@@ -242,7 +256,7 @@ def audit(skill: str = "grasp", axis: Optional[str] = None, objects: Optional[st
     kw.pop("object_limit", None)
     kw.pop("reconfiguration_freq", None)
     objs = get_object_set(objects or skill_entry(skill).train_objects, limit=limit)
-    beh = behaviour_set if behaviour_set is not None else behaviours(skill)
+    beh = behaviour_set if behaviour_set is not None else behaviours(skill, axis=axis, hand=hand)
     if only:
         bad = [b for b in only if b not in beh]
         if bad:
@@ -283,7 +297,7 @@ def audit(skill: str = "grasp", axis: Optional[str] = None, objects: Optional[st
     bar.close()
     mean = lambda xs: sum(xs) / max(len(xs), 1)
     rows = [AuditRow(b, len(a["total"]), mean(a["succeeded"]), mean(a["total"]), {t: mean(a["terms"][t]) for t in terms},
-                     mean(a["raw"]), min(a["total"])) for b, a in acc.items()]
+                     mean(a["raw"]), min(a["total"]), a["total"], a["succeeded"]) for b, a in acc.items()]
     return sorted(rows, key=lambda r: -r.total)
 
 

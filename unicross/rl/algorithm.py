@@ -33,7 +33,8 @@ class PPO:
     ``frames_per_batch`` sizes the replay buffer the minibatches are drawn from."""
 
     def __init__(self, dims: Dict[str, int], n_act: int, cfg: dict, frames_per_batch: int, device="cpu"):
-        self.cfg = cfg
+        self.cfg, self.n_act = cfg, n_act
+        self.updates = 0  # updates done (optim.critic_warmup counts them)
         oc = cfg["optim"]
         if oc["schedule"] not in ("fixed", "adaptive"):
             raise ValueError(f"optim.schedule must be 'fixed' or 'adaptive', not {oc['schedule']!r}")
@@ -66,16 +67,29 @@ class PPO:
         """The bare network ``(hand, object, goal) -> (loc, scale)`` the collector's workers run."""
         return self.policy.module[0].module
 
+    @torch.no_grad()
+    def start_policy_from(self, ck: dict, name) -> None:
+        """Starts the actor from the policy of checkpoint ``ck`` (its weights and observation
+        statistics, which the critic shares); the exploration noise stays at ``model.init_log_std``."""
+        dims = {k: getattr(self.norm, f"{k}_mean").numel() for k in self.norm.keys}
+        if dict(ck["obs_dims"]) != dims or int(ck["n_act"]) != self.n_act:
+            raise ValueError(f"model.init_policy={name}: observation sizes {ck['obs_dims']} and {ck['n_act']} actions, "
+                             f"this run has {dims} and {self.n_act}")
+        log_std = self.actor.log_std.clone()
+        self.policy.load_state_dict(ck["policy"])
+        self.actor.log_std.copy_(log_std)
+
     # ------------------------------------------------------------------ state
     def state_dict(self) -> dict:
         return dict(policy=self.policy.state_dict(), value=self.value.state_dict(), optim=self.optim.state_dict(),
-                    lr=self.lr)
+                    lr=self.lr, updates=self.updates)
 
     def load_state_dict(self, state: dict) -> None:
         self.policy.load_state_dict(state["policy"])
         self.value.load_state_dict(state["value"])
         self.optim.load_state_dict(state["optim"])
         self.lr = state["lr"]
+        self.updates = int(state.get("updates", 0))
         for g in self.optim.param_groups:
             g["lr"] = self.lr
 
@@ -112,11 +126,12 @@ class PPO:
         stats.update(grad_norm_actor=0.0, grad_norm_critic=0.0)
         count, stopped = 0, False
         kl_stop = oc.get("kl_stop")
+        critic_only = self.updates < int(oc.get("critic_warmup") or 0)
         for _ in range(oc["mini_epochs"]):
             if stopped:
                 break
             for _ in range(n_mb):
-                klv = self._step(self.rb.sample(), stats, first=count == 0)
+                klv = self._step(self.rb.sample(), stats, first=count == 0, critic_only=critic_only)
                 count += 1
                 if kl_stop is not None and klv > kl_stop:  # the policy moved far enough for this batch
                     stopped = True
@@ -127,26 +142,31 @@ class PPO:
         out["kl"] = out.pop("kl_approx")
         out["lr"] = self.lr
         out["minibatch_steps"] = count
+        out["critic_only"] = float(critic_only)
+        self.updates += 1
         out["value_mean"], out["value_std"] = float(vn.mean), float(vn.std())
         return out
 
-    def _step(self, mb: TensorDict, stats: dict, first: bool = False) -> float:
+    def _step(self, mb: TensorDict, stats: dict, first: bool = False, critic_only: bool = False) -> float:
         """One minibatch gradient step; adds its diagnostics to ``stats``; returns its KL. ``first``:
         the update's first step, whose KL is measured on the policy that collected the batch (0 by
         construction), so it does not move the adaptive rate (it would always raise it; with
-        ``kl_stop`` that pinned the rate at ``lr_max``: one step per update at the largest rate)."""
+        ``kl_stop`` that pinned the rate at ``lr_max``: one step per update at the largest rate).
+        ``critic_only``: the critic's loss alone (``optim.critic_warmup``); the actor stays as it is."""
         oc = self.cfg["optim"]
         losses = self.loss(mb)
-        loss = losses["loss_objective"] + losses["loss_critic"]
-        if "loss_entropy" in losses.keys():
-            loss = loss + losses["loss_entropy"]
+        loss = losses["loss_critic"]
+        if not critic_only:
+            loss = loss + losses["loss_objective"]
+            if "loss_entropy" in losses.keys():
+                loss = loss + losses["loss_entropy"]
         self.optim.zero_grad(set_to_none=True)
         loss.backward()
         ga = torch.nn.utils.clip_grad_norm_(self._actor_params, oc["max_grad_norm"])
         gc = torch.nn.utils.clip_grad_norm_(self._critic_params, oc["max_grad_norm_critic"])
         self.optim.step()
         klv = float(losses["kl_approx"])
-        if not first:
+        if not first and not critic_only:
             self._schedule_lr(klv)
         for k in LOSS_KEYS:
             if k in losses.keys():

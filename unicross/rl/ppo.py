@@ -66,6 +66,21 @@ def env_kwargs_for(skill: str, axis: Optional[str], hand: str, env_cfg: dict) ->
     return kw
 
 
+def policy_to_start_from(path, skill: str, axis: Optional[str], hand: str) -> dict:
+    """The policy checkpoint that ``model.init_policy`` names (e.g. a gait cloned by
+    ``benchmarks/gait_clone.py``), refused unless it acts for this run's skill, axis and hand."""
+    from unicross.rl.policy_io import read_torch_file, resolve_checkpoint, check_modes
+    path = resolve_checkpoint(path)
+    ck = read_torch_file(path, "checkpoint")
+    if not isinstance(ck, dict) or "policy" not in ck or "obs_dims" not in ck:
+        raise ValueError(f"model.init_policy={path} is not a UniCross policy checkpoint")
+    check_modes(ck, path)
+    theirs, ours = (ck.get("skill"), ck.get("axis"), ck.get("hand")), (skill, axis, hand)
+    if theirs != ours:
+        raise ValueError(f"model.init_policy={path} acts for skill/axis/hand {theirs}, this run trains {ours}")
+    return ck
+
+
 def evaluation_shard(actor, skill: str, objects: str, limit, trials_per_object: int, seed: int, hand: str,
                      axis: Optional[str], ablation: Optional[dict], shard) -> list:
     """One worker's share of a held-out evaluation (see :meth:`PPOTrainer._protocol`)."""
@@ -105,8 +120,10 @@ class PPOTrainer(Runner):
         skill, hand = skill or "grasp", hand or "allegro"
         from unicross.robots.hand import load_hand
         spec = load_hand(hand)  # validates
-        start_mean = None
-        if self.ckpt is None and cfg["model"].get("init_reference") is not None:  # refused before any simulation
+        start_mean, start_policy = None, None
+        if self.ckpt is None and cfg["model"].get("init_policy"):  # refused before any simulation
+            start_policy = policy_to_start_from(cfg["model"]["init_policy"], skill, axis, hand)
+        if self.ckpt is None and cfg["model"].get("init_reference") is not None:
             from unicross.audit import reference_action
             start_mean = reference_action(skill, axis, spec, float(cfg["model"]["init_reference"]))
         self.skill, self.axis, self.hand = skill, axis, hand
@@ -126,6 +143,8 @@ class PPOTrainer(Runner):
         self.algo = PPO(dims, self.n_act, cfg, self.collector.frames_per_batch, self.device)
         if start_mean is not None:
             self.algo.actor.start_mean_at(start_mean.to(self.device))
+        if start_policy is not None:
+            self.algo.start_policy_from(start_policy, cfg["model"]["init_policy"])
         self.iteration, self.frames = 0, 0
         self.dims = dims
         if self.ckpt is not None:

@@ -1,0 +1,175 @@
+"""DAgger of a scripted finger gait into a network policy: can a policy that sees only the
+observation do what a gait does with its clock and its privileged stop?
+
+A shipped rotate gait (:mod:`unicross.gaits`) acts from the control step, the start command and
+the object's accumulated rotation (read from the task's state); the UniCross policy network sees
+s^h, s^o and g. This script labels states with the gait and fits the network to the labels
+(DAgger, Ross et al. 2011): round 0 rolls the gait out, every later round rolls the current network
+out (its mean action) and the gait labels the states the network visits (the gait's label is a
+step toward its own trajectory from the current joint command, and its stop follows the object's
+actual rotation, so it is defined on any state); the network is refitted on everything gathered
+(MSE on the action mean, the observation normaliser fitted to the data); the network kept is the
+one whose own rollouts succeeded most often. Rollouts run the rotate
+protocol on training objects (400 steps, the evaluation's conditions unless ``--randomize``),
+split over ``--workers`` processes; each round prints the network's own success rate.
+
+The result is a policy checkpoint in the shipped format (``unicross eval --policy OUT/policy.pt``),
+and a PPO run can start from it (``unicross train ... --set model.init_policy=OUT/policy.pt``):
+
+    python benchmarks/gait_clone.py --gait allegro/rotate_y- --limit 8 --trials 2 --rounds 5 \
+        --out docs/runs/gait_clone/rotate_y-
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import multiprocessing as mp
+import sys
+import time
+from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
+
+import torch
+
+from unicross import formulation as F
+
+
+def _rollouts(gait: str, hand: str, objects: str, limit: int, trials: int, seed: int, randomize: bool,
+              student, shard) -> tuple:
+    """One worker's share: (obs dict of [N, d], labels [N, A], trials) of the rotate protocol on its
+    objects, the gait acting (``student`` None) or the student's mean acting while the gait labels."""
+    torch.set_num_threads(1)
+    import unicross  # noqa: F401  (registers the tasks)
+    from unicross import evaluation as E
+    from unicross.gaits import best_gait, gait_mode, make_gait_policy, resolve_gait
+    from unicross.objects import get_object_set
+    from unicross.rl.env import split_obs
+    from unicross.rl.policy_io import actor_action
+    teacher = make_gait_policy(gait)
+    axis = gait_mode(best_gait(resolve_gait(gait))[1]).split("_")[1]
+    keys = ("hand", "object", "goal")
+    rows = {k: [] for k in keys}
+    labels = []
+
+    def policy(obs, u):
+        label = teacher(obs, u)
+        for k, x in zip(keys, split_obs(obs)):
+            rows[k].append(x.clone())
+        labels.append(label.clone())
+        return label if student is None else actor_action(student, obs)
+
+    out = E.run_protocol("rotate", policy, get_object_set(objects, limit=limit), hand=hand, trials_per_object=trials,
+                         seed=seed, randomize=randomize, axes=[axis], progress=False, shard=shard)
+    return {k: torch.cat(v) for k, v in rows.items()}, torch.cat(labels), out
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--gait", required=True, help="a shipped gait (allegro/rotate_y-) or a gait_search log")
+    ap.add_argument("--hand", default="allegro")
+    ap.add_argument("--objects", default="train")
+    ap.add_argument("--limit", type=int, default=8, help="first N objects per group of --objects")
+    ap.add_argument("--trials", type=int, default=2, help="episodes per object per round")
+    ap.add_argument("--rounds", type=int, default=5, help="round 0: the gait acts; then the network")
+    ap.add_argument("--epochs", type=int, default=30, help="passes over the aggregated data after each round")
+    ap.add_argument("--batch", type=int, default=512)
+    ap.add_argument("--lr", type=float, default=1e-3)
+    ap.add_argument("--randomize", action="store_true", help="training's randomisation (default: the evaluation's conditions)")
+    ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--out", required=True)
+    args = ap.parse_args(argv)
+
+    import unicross  # noqa: F401
+    from unicross.config import load_config
+    from unicross.gaits import best_gait, gait_mode, resolve_gait
+    from unicross.rl.models import make_models
+    from unicross.rl.ppo import env_kwargs_for
+    from unicross.rl.runner import git_commit
+    from unicross import registry as R
+    mode = gait_mode(best_gait(resolve_gait(args.gait))[1])  # fails before any simulation
+    skill, axis = mode.split("_")
+    cfg = load_config("ppo")
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    torch.manual_seed(args.seed)
+
+    obs = None
+    labels = None
+    policy = actor = None
+    log = []
+    fitted = {}  # round -> the network that round rolled out (its state, its success rate)
+    t0 = time.time()
+    ctx = mp.get_context("spawn")
+    for r in range(args.rounds + 1):
+        student = None if r == 0 else actor
+        with ProcessPoolExecutor(args.workers, mp_context=ctx) as ex:
+            parts = [f.result() for f in [ex.submit(_rollouts, args.gait, args.hand, args.objects, args.limit,
+                                                     args.trials, args.seed + 7919 * r, args.randomize, student,
+                                                     (i, args.workers)) for i in range(args.workers)]]
+        o = {k: torch.cat([p[0][k] for p in parts]) for k in parts[0][0]}
+        y = torch.cat([p[1] for p in parts])
+        trials = [t for p in parts for t in p[2]]
+        sr = sum(t["success"] for t in trials) / len(trials)
+        drops = sum(t["dropped"] for t in trials) / len(trials) if "dropped" in trials[0] else float("nan")
+        who = "gait" if r == 0 else "network"
+        row = dict(round=r, actor=who, episodes=len(trials), success=sr, dropped=drops, new_states=len(y),
+                   wall_s=round(time.time() - t0, 1))
+        if r > 0:
+            fitted[r]["success"] = sr
+        if r == args.rounds:  # the last round only measures the final network
+            log.append(row)
+            print(json.dumps(row), flush=True)
+            break
+        obs = o if obs is None else {k: torch.cat([obs[k], o[k]]) for k in o}
+        labels = y if labels is None else torch.cat([labels, y])
+        if policy is None:
+            dims = {k: v.shape[-1] for k, v in obs.items()}
+            policy, _, norm = make_models(dims, y.shape[-1], None, cfg["model"])
+            actor = policy.module[0].module
+        with torch.no_grad():  # the statistics of all the data so far
+            for k in dims:
+                getattr(norm, f"{k}_mean").zero_()
+                getattr(norm, f"{k}_var").fill_(1.0)
+            norm.count.fill_(1e-4)
+        norm.update(obs)
+        opt = torch.optim.Adam(actor.net.parameters(), lr=args.lr)
+        n = len(labels)
+        for _ in range(args.epochs):
+            perm = torch.randperm(n)
+            for i in range(0, n, args.batch):
+                idx = perm[i:i + args.batch]
+                loc, _ = actor(obs["hand"][idx], obs["object"][idx], obs["goal"][idx])
+                loss = torch.nn.functional.mse_loss(loc, labels[idx])
+                opt.zero_grad()
+                loss.backward()
+                opt.step()
+        with torch.no_grad():
+            loc, _ = actor(obs["hand"], obs["object"], obs["goal"])
+            row["mse"] = float(torch.nn.functional.mse_loss(loc.clamp(-1, 1), labels))
+            row["label_var"] = float(labels.var(0).mean())
+            row["states"] = n
+        fitted[r + 1] = dict(state={k: v.clone() for k, v in policy.state_dict().items()})
+        log.append(row)
+        print(json.dumps(row), flush=True)
+        with open(out / "log.jsonl", "w") as f:
+            f.writelines(json.dumps(x) + "\n" for x in log)
+
+    best = max(fitted, key=lambda k: (fitted[k]["success"], k))
+    log.append(dict(kept_round=best, success=fitted[best]["success"]))
+    ck = dict(policy=fitted[best]["state"], obs_dims=dims, n_act=labels.shape[-1], modes=list(F.MODES), config=cfg,
+              skill=skill, axis=axis, hand=args.hand, env_id=R.skill(skill).env_id,
+              env_kwargs=env_kwargs_for(skill, axis, args.hand, cfg["env"]), iteration=0, frames=0,
+              git_commit=git_commit(), commits=[git_commit()])
+    torch.save(ck, out / "policy.pt")
+    with open(out / "log.jsonl", "w") as f:
+        f.writelines(json.dumps(x) + "\n" for x in log)
+    (out / "command.txt").write_text("python benchmarks/gait_clone.py " + " ".join(sys.argv[1:] if argv is None else argv)
+                                     + f"  # commit {git_commit()}\n")
+    print(f"wrote {out / 'policy.pt'}: the network of round {best} ({100 * fitted[best]['success']:.1f}% "
+          f"of its episodes; {time.time() - t0:.0f} s)")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
