@@ -201,11 +201,14 @@ class PPOTrainer(Runner):
     def evaluate(self) -> dict:
         """The in-training evaluation: a fixed held-out set (``logging.eval_objects``, first
         ``eval_limit`` objects per group, ``eval_trials`` trials each) with fixed seeds, so every
-        evaluation of a run sees the same objects and starts."""
+        evaluation of a run sees the same objects and starts. The pose, angle and distance
+        columns are means over the trials that kept the object (``eval_non_dropped`` of
+        ``eval_n``): NaN when every trial dropped it."""
         lc = self.cfg["logging"]
         _, summ = self._protocol(lc["eval_objects"], lc["eval_limit"], lc["eval_trials"], lc["eval_seed"])
         out = dict(eval_success=summ["sr"] / 100.0, eval_ci95_low=summ["ci95"][0] / 100.0,
-                   eval_ci95_high=summ["ci95"][1] / 100.0, eval_n=summ["n"])
+                   eval_ci95_high=summ["ci95"][1] / 100.0, eval_n=summ["n"],
+                   eval_non_dropped=summ["non_dropped"])
         for k in ("pe_cm", "ae_rad", "rot_rad", "trans_cm"):
             if k in summ:
                 out[f"eval_{k}"] = summ[k]
