@@ -9,7 +9,9 @@ out (its mean action) and the gait labels the states the network visits (the gai
 step toward its own trajectory from the current joint command, and its stop follows the object's
 actual rotation, so it is defined on any state); the network is refitted on everything gathered
 (MSE on the action mean, the observation normaliser fitted to the data); the network kept is the
-one whose own rollouts succeeded most often. Rollouts run the rotate
+one whose own rollouts succeeded most often (with ``--beta``, DAgger's mixture: in round r the
+gait takes over a fraction beta**r of the network's steps, and only the last round, the network
+alone, selects). Rollouts run the rotate
 protocol on training objects (400 steps, the evaluation's conditions unless ``--randomize``),
 split over ``--workers`` processes; each round prints the network's own success rate.
 
@@ -35,9 +37,11 @@ from unicross import formulation as F
 
 
 def _rollouts(gait: str, hand: str, objects: str, limit: int, trials: int, seed: int, randomize: bool,
-              student, shard) -> tuple:
+              student, shard, beta: float = 0.0) -> tuple:
     """One worker's share: (obs dict of [N, d], labels [N, A], trials) of the rotate protocol on its
-    objects, the gait acting (``student`` None) or the student's mean acting while the gait labels."""
+    objects, the gait acting (``student`` None) or the student's mean acting while the gait labels;
+    with ``beta`` > 0 the gait's own action is taken instead at that fraction of the steps (each env
+    and step drawn on its own: DAgger's mixture policy)."""
     torch.set_num_threads(1)
     import unicross  # noqa: F401  (registers the tasks)
     from unicross import evaluation as E
@@ -50,13 +54,20 @@ def _rollouts(gait: str, hand: str, objects: str, limit: int, trials: int, seed:
     keys = ("hand", "object", "goal")
     rows = {k: [] for k in keys}
     labels = []
+    mix = torch.Generator().manual_seed(seed + 104729 * shard[0])
 
     def policy(obs, u):
         label = teacher(obs, u)
         for k, x in zip(keys, split_obs(obs)):
             rows[k].append(x.clone())
         labels.append(label.clone())
-        return label if student is None else actor_action(student, obs)
+        if student is None:
+            return label
+        act = actor_action(student, obs)
+        if beta > 0:
+            gait_steps = torch.rand(act.shape[0], 1, generator=mix) < beta
+            act = torch.where(gait_steps, label, act)
+        return act
 
     out = E.run_protocol("rotate", policy, get_object_set(objects, limit=limit), hand=hand, trials_per_object=trials,
                          seed=seed, randomize=randomize, axes=[axis], progress=False, shard=shard)
@@ -74,6 +85,8 @@ def main(argv=None) -> int:
     ap.add_argument("--epochs", type=int, default=30, help="passes over the aggregated data after each round")
     ap.add_argument("--batch", type=int, default=512)
     ap.add_argument("--lr", type=float, default=1e-3)
+    ap.add_argument("--beta", type=float, default=0.0,
+                    help="DAgger's mixture: in round r the gait acts at beta**r of the network's steps (0: never)")
     ap.add_argument("--randomize", action="store_true", help="training's randomisation (default: the evaluation's conditions)")
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--seed", type=int, default=0)
@@ -101,21 +114,26 @@ def main(argv=None) -> int:
     fitted = {}  # round -> the network that round rolled out (its state, its success rate)
     t0 = time.time()
     ctx = mp.get_context("spawn")
+
+    def beta_of(r: int) -> float:  # the last round measures the network alone
+        return 0.0 if r in (0, args.rounds) else args.beta ** r
+
     for r in range(args.rounds + 1):
         student = None if r == 0 else actor
         with ProcessPoolExecutor(args.workers, mp_context=ctx) as ex:
             parts = [f.result() for f in [ex.submit(_rollouts, args.gait, args.hand, args.objects, args.limit,
                                                      args.trials, args.seed + 7919 * r, args.randomize, student,
-                                                     (i, args.workers)) for i in range(args.workers)]]
+                                                     (i, args.workers), beta_of(r))
+                                           for i in range(args.workers)]]
         o = {k: torch.cat([p[0][k] for p in parts]) for k in parts[0][0]}
         y = torch.cat([p[1] for p in parts])
         trials = [t for p in parts for t in p[2]]
         sr = sum(t["success"] for t in trials) / len(trials)
         drops = sum(t["dropped"] for t in trials) / len(trials) if "dropped" in trials[0] else float("nan")
-        who = "gait" if r == 0 else "network"
+        who = "gait" if r == 0 else ("network" if beta_of(r) == 0 else f"network, gait at {beta_of(r):.3g} of steps")
         row = dict(round=r, actor=who, episodes=len(trials), success=sr, dropped=drops, new_states=len(y),
                    wall_s=round(time.time() - t0, 1))
-        if r > 0:
+        if r > 0 and beta_of(r) == 0:  # only rollouts of the network alone select it
             fitted[r]["success"] = sr
         if r == args.rounds:  # the last round only measures the final network
             log.append(row)
@@ -155,7 +173,7 @@ def main(argv=None) -> int:
         with open(out / "log.jsonl", "w") as f:
             f.writelines(json.dumps(x) + "\n" for x in log)
 
-    best = max(fitted, key=lambda k: (fitted[k]["success"], k))
+    best = max((k for k in fitted if "success" in fitted[k]), key=lambda k: (fitted[k]["success"], k))
     log.append(dict(kept_round=best, success=fitted[best]["success"]))
     ck = dict(policy=fitted[best]["state"], obs_dims=dims, n_act=labels.shape[-1], modes=list(F.MODES), config=cfg,
               skill=skill, axis=axis, hand=args.hand, env_id=R.skill(skill).env_id,

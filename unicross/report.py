@@ -111,7 +111,8 @@ class PaperReport:
                 gait = " (a scripted gait: see below)" if who == "expert" and mode in self.gaits else ""
                 rows.append((mode, f"{who} not shipped{gait}", "--"))
             elif who == "student" and mode not in self.student_modes:
-                rows.append((mode, f"{spec} (not distilled for this mode: no expert)", "--"))
+                why = "" if mode in self.ckpts else ": no expert"
+                rows.append((mode, f"{spec} (not distilled for this mode{why})", "--"))
             else:
                 rows.append((mode, spec, self.evaluate(mode, spec, objects, disturb)))
         return rows
@@ -191,7 +192,7 @@ class PaperReport:
         trials = run_chain(policy, objs, hand=self.hand, trials_per_object=self.trials_per_object(per_sequence),
                            seed=self.seed, progress=False)
         missing = [m for m in F.MODES if m not in self.student_modes]
-        note = ([f"The student was distilled for {', '.join(self.student_modes)} only (no expert for "
+        note = ([f"The student was distilled for {', '.join(self.student_modes)} only (not for "
                  f"{', '.join(missing)}): phases of those modes are not expected to succeed.", ""] if missing else [])
         by_mode = "; ".join(f"{m} {sr_cell(v)}" for m, v in chain_last_phase_by_mode(trials).items())
         return note + [chain_table(summarize_chain(trials)), "", f"In-hand phase by mode: {by_mode}.", "",
