@@ -190,6 +190,7 @@ class TaskScene:
         self.finger_q0 = torch.zeros(n, dof - 6, device=dev)
         self.rot_acc = torch.zeros(n, device=dev)
         self.trans_acc = torch.zeros(n, device=dev)
+        self.success_paid = torch.zeros(n, device=dev)  # the success reward term's sum over the episode
         self.ever_dropped = torch.zeros(n, dtype=torch.bool, device=dev)
         self.obj_z0 = torch.zeros(n, device=dev)
         self.lift = z3.clone()

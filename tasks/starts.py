@@ -114,6 +114,7 @@ class EpisodeStarts:
         self.finger_q0[env_idx] = finger_q0
         self.rot_acc[env_idx] = 0
         self.trans_acc[env_idx] = 0
+        self.success_paid[env_idx] = 0
         self.obj_z0[env_idx] = obj_p[:, 2]
         self.lift[env_idx] = 0
         self._pending[env_idx] = True

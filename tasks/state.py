@@ -36,7 +36,7 @@ class TaskStateIO:
     under ``"task"`` as float columns (its flat state vector concatenates them)."""
 
     TASK_STATE = ("root_p", "root_q", "init_rel", "targets", "prev_rel", "final_x_or", "final_q_or", "axis",
-                  "command", "finger_q0", "rot_acc", "trans_acc", "ever_dropped", "obj_z0", "lift", "perturb",
+                  "command", "finger_q0", "rot_acc", "trans_acc", "success_paid", "ever_dropped", "obj_z0", "lift", "perturb",
                   "obs_noise", "obj_vel_h", "obj_angvel_h", "hand_vel", "hand_angvel", "link_force", "disturb", "mode")
 
     def task_state(self) -> TensorDict:

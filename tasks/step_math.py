@@ -149,8 +149,9 @@ class StepMath:
                     speed_cap=self._speed_cap[self.mode], relational=cur, reward_targets=reward_targets,
                     finger_qpos=m["qpos"][:, 6:], finger_qpos0=self.finger_q0, hand_lin_vel=self.hand_vel,
                     hand_ang_vel=self.hand_angvel, finger_torque=m["finger_torque"], drop=drop, held=held, success=success,
-                    goal_err_prev=goal_err_prev, goal_err=goal_err)
+                    goal_err_prev=goal_err_prev, goal_err=goal_err, success_paid=self.success_paid)
         terms = self.rewards(self.mode, meas)
+        self.success_paid = torch.where(pend, self.success_paid + terms["success"], self.success_paid)
         self._observation_parts(m, cur, contact, force_c)
         info = dict(success=success, fail=drop, drop=drop, ever_dropped=self.ever_dropped.clone(),
                     lifted=lifted, relocate_pos_err=pos_err, relocate_rot_err=rot_err,

@@ -113,7 +113,8 @@ def measurements(n: int, L: int = 5, seed: int = 0) -> dict:
                 relational=rel, reward_targets=rel.clone(), finger_qpos=torch.randn(n, 16, generator=g),
                 finger_qpos0=torch.randn(n, 16, generator=g), hand_lin_vel=torch.randn(n, 3, generator=g),
                 hand_ang_vel=torch.randn(n, 3, generator=g), finger_torque=torch.randn(n, 16, generator=g),
-                drop=torch.rand(n, generator=g) > 0.8, held=torch.ones(n, dtype=torch.bool))
+                drop=torch.rand(n, generator=g) > 0.8, held=torch.ones(n, dtype=torch.bool),
+                success_paid=torch.rand(n, generator=g) * 50)
 
 
 def test_every_registered_term_is_computed_finite_and_per_env():
@@ -159,6 +160,20 @@ def test_contact_distance_saturates_and_motion_is_capped():
     lost = RW.motion_reward(dict(m, speed_along_axis=torch.tensor([5.0, -5.0]), held=torch.zeros(2, dtype=torch.bool)),
                             cm, mode)
     assert torch.equal(lost, torch.zeros(2))  # nothing after a drop: the paper's episode would have ended
+
+
+def test_success_bonus_is_taken_back_at_a_drop_where_configured():
+    """``success_revoke_on_drop``: at the step a drop is detected (dropped now, held before) the
+    success term returns minus what it paid in the episode; later dropped steps, a held object and
+    skills without the switch are untouched."""
+    cfg = load_config("reward")
+    assert cfg["success_revoke_on_drop"]["rotate"] and not cfg["success_revoke_on_drop"]["translate"]
+    c = RW.RewardTerms(cfg, "cpu").coefficients("success")
+    m = dict(success=torch.tensor([False, False, True, False]), drop=torch.tensor([True, True, False, True]),
+             held=torch.tensor([True, False, True, True]), success_paid=torch.tensor([120.0, 120.0, 30.0, 120.0]))
+    rot = torch.tensor([F.MODES.index("rotate_y-")] * 3 + [F.MODES.index("translate_z+")])
+    w = cfg["success"]["rotate"]
+    assert RW.success_reward(m, c, rot).tolist() == [-120.0, 0.0, w, 0.0]
 
 
 def test_progress_term_telescopes_to_the_error_reduction():

@@ -90,10 +90,19 @@ def motion_reward(m: dict, c: dict, mode: torch.Tensor) -> torch.Tensor:
     return c["w_p"][mode] * v * m["held"].float()
 
 
-@reward_term("success", lambda cfg, dev: dict(w=per_mode(cfg["success"], dev)))
+def _success_coefficients(cfg: dict, dev) -> dict:
+    revoke = cfg.get("success_revoke_on_drop") or {s: False for s in cfg["success"]}
+    return dict(w=per_mode(cfg["success"], dev), revoke=per_mode({s: float(v) for s, v in revoke.items()}, dev))
+
+
+@reward_term("success", _success_coefficients)
 def success_reward(m: dict, c: dict, mode: torch.Tensor) -> torch.Tensor:
-    """w_success · [the mode's success holds at this step]."""
-    return c["w"][mode] * m["success"].float()
+    """w_success · [the mode's success holds at this step], and with ``success_revoke_on_drop``
+    minus everything this term has paid in the episode (``success_paid``, before this step) at the
+    step the object is dropped: success counts only if the object is never dropped, so an episode
+    that passes the threshold and then drops it nets no bonus."""
+    first_drop = (m["drop"] & m["held"]).float()
+    return c["w"][mode] * m["success"].float() - c["revoke"][mode] * m["success_paid"] * first_drop
 
 
 @reward_term("progress", lambda cfg, dev: dict(w_pos=per_mode(cfg["progress"], dev, "w_pos"),
