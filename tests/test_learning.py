@@ -199,17 +199,22 @@ def test_shipped_relocate_expert_relocates_a_held_out_object():
         E.resolve_policy("allegro/relocate", "mano")
 
 
+def _shipped_and_zero(spec: str, skill: str, axis: str, objects, trials_per_object: int):
+    """(trials of the shipped checkpoint ``spec``, trials of the zero action) under the paper's
+    protocol of ``skill`` about/along ``axis`` on ``objects``; checks the checkpoint's mode first."""
+    from unicross import evaluation as E
+    policy, desc = E.resolve_policy(spec, "allegro")
+    assert (desc["skill"], desc.get("axis")) == (skill, axis)
+    kw = dict(trials_per_object=trials_per_object, seed=0, progress=False, axes=[axis])
+    return E.run_protocol(skill, policy, objects, **kw), E.run_protocol(skill, E.zero_policy, objects, **kw)
+
+
 def test_shipped_translate_expert_translates_a_held_out_object():
     """The shipped translate z+ expert (allegro/translate_z+) slides a held elongated test object
     out along the fingers under the paper's translate protocol, farther than the zero action."""
-    from unicross import evaluation as E
     from unicross.objects import get_object_set
-    policy, desc = E.resolve_policy("allegro/translate_z+", "allegro")
-    assert (desc["skill"], desc.get("axis")) == ("translate", "z+")
-    obj = get_object_set("test-elongated", limit=1)[:1]
-    kw = dict(trials_per_object=2, seed=0, progress=False, axes=["z+"])
-    trials = E.run_protocol("translate", policy, obj, **kw)
-    zero = E.run_protocol("translate", E.zero_policy, obj, **kw)
+    trials, zero = _shipped_and_zero("allegro/translate_z+", "translate", "z+",
+                                     get_object_set("test-elongated", limit=1)[:1], trials_per_object=2)
     assert sum(t["success"] for t in trials) >= 1 and not any(t["success"] for t in zero)
 
 
@@ -218,14 +223,9 @@ def test_shipped_rotate_policy_turns_a_held_out_object():
     acting from the observation alone) turns a held test object past pi/2 about the hand's y- axis
     without dropping it, where the zero action turns none (first two test objects, 3 trials each:
     the start of the recorded held-out evaluation, 2 of those 6 succeeded there)."""
-    from unicross import evaluation as E
     from unicross.objects import get_object_set
-    policy, desc = E.resolve_policy("allegro/rotate_y-", "allegro")
-    assert (desc["skill"], desc.get("axis")) == ("rotate", "y-")
-    objs = get_object_set("test", limit=20)[:2]
-    kw = dict(trials_per_object=3, seed=0, progress=False, axes=["y-"])
-    trials = E.run_protocol("rotate", policy, objs, **kw)
-    zero = E.run_protocol("rotate", E.zero_policy, objs, **kw)
+    trials, zero = _shipped_and_zero("allegro/rotate_y-", "rotate", "y-", get_object_set("test", limit=20)[:2],
+                                     trials_per_object=3)
     assert sum(t["success"] for t in trials) >= 1 and not any(t["success"] for t in zero)
 
 

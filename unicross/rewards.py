@@ -90,12 +90,8 @@ def motion_reward(m: dict, c: dict, mode: torch.Tensor) -> torch.Tensor:
     return c["w_p"][mode] * v * m["held"].float()
 
 
-def _success_coefficients(cfg: dict, dev) -> dict:
-    revoke = cfg.get("success_revoke_on_drop") or {s: False for s in cfg["success"]}
-    return dict(w=per_mode(cfg["success"], dev), revoke=per_mode({s: float(v) for s, v in revoke.items()}, dev))
-
-
-@reward_term("success", _success_coefficients)
+@reward_term("success", lambda cfg, dev: dict(w=per_mode(cfg["success"], dev),
+                                              revoke=per_mode(cfg["success_revoke_on_drop"], dev)))
 def success_reward(m: dict, c: dict, mode: torch.Tensor) -> torch.Tensor:
     """w_success · [the mode's success holds at this step], and with ``success_revoke_on_drop``
     minus everything this term has paid in the episode (``success_paid``, before this step) at the
