@@ -96,3 +96,34 @@ def test_critic_warmup_leaves_the_actor_alone_then_hands_over():
     assert other.updates == 2
     assert algo.update(bandit_batch(algo, g))["critic_only"] == 0.0
     assert not all(torch.equal(a, b) for a, b in zip(actor0, algo.actor.parameters()))
+
+
+def test_teacher_term_pulls_the_mean_to_the_teacher_and_decays():
+    """``loss.teacher_coef``: with no reward to follow, the actor's mean moves to the teacher's
+    action on the batch's states; without the term it stays near 0; the weight decays by
+    ``loss.teacher_decay`` per actor update (counted after the critic warm-up)."""
+    target = torch.tensor([0.6, -0.4, 0.2])
+
+    def run(coef):
+        cfg = load_config("ppo", {"loss": {"teacher_coef": coef, "teacher_decay": 0.8}, "optim": {"critic_warmup": 1}})
+        torch.manual_seed(0)
+        algo = PPO(DIMS, A, cfg, frames_per_batch=N * T)
+        g = torch.Generator().manual_seed(5)
+        coefs = []
+        for _ in range(12):
+            buf = bandit_batch(algo, g)
+            buf["next", "reward"].zero_()
+            buf["teacher_action"] = target.expand(N, T, A).clone()
+            out = algo.update(buf)
+            coefs.append(out["teacher_coef"])
+        with torch.no_grad():
+            obs = [torch.randn(256, DIMS[k], generator=g) for k in OBS_KEYS]
+            return algo.actor(*obs)[0].mean(0), coefs, out
+
+    mean, coefs, out = run(20.0)
+    assert coefs[:4] == pytest.approx([0.0, 20.0, 16.0, 12.8])
+    assert out["loss_teacher"] > 0
+    torch.testing.assert_close(mean, target, atol=0.15, rtol=0)
+    mean0, _, out0 = run(0.0)
+    assert out0["loss_teacher"] == 0.0
+    assert (mean0 - target).abs().max() > 0.15

@@ -8,6 +8,7 @@ from unicross.rl import collector as C
 from unicross.rl.collector import LeanCollector, make_collector, one_thread, update_threads, usable_cores
 from unicross.rl.models import make_models
 
+R_ID = "UniCross-Rotate-v1"
 KW = dict(object_limit=1, reconfiguration_freq=1, config={"terminate_on_drop": False})  # episodes end at 64 steps
 
 
@@ -170,3 +171,50 @@ def test_ray_env_actors_collect_what_local_workers_collect():
         local.close()
         remote.close()
         ray.shutdown()
+
+
+class _ZeroActor(torch.nn.Module):
+    def forward(self, hand, obj, goal):
+        loc = torch.zeros(hand.shape[0], 22)
+        return loc, torch.full_like(loc, 0.1)
+
+
+def test_a_gait_teacher_labels_every_collected_state():
+    """``collector.teacher``: the batch's ``teacher_action`` is what the gait, run alongside on an
+    identical env that takes the same actions, gives in each collected state."""
+    import gymnasium as gym
+    from unicross.config import load_config
+    from unicross.rl.ppo import env_kwargs_for
+    kw = dict(env_kwargs_for("rotate", "y-", "allegro", load_config("ppo")["env"]), object_limit=1)
+    c = LeanCollector(R_ID, kw, num_envs=1, horizon=6, seed=5, deterministic=True, teacher="allegro/rotate_y-")
+    try:
+        c.set_actor(_ZeroActor())
+        data = c.collect()
+    finally:
+        c.close()
+    twin = gym.make(R_ID, render_backend="none", obs_mode="state_dict", num_envs=1, sim_backend="physx_cpu", **kw)
+    try:
+        u = twin.unwrapped
+        u.reset(seed=5)
+        gait = C.make_teacher("allegro/rotate_y-")
+        for t in range(6):
+            label = gait(u)
+            torch.testing.assert_close(data["teacher_action"][:, t], label)
+            u.step(data["action"][:, t])
+    finally:
+        twin.close()
+    assert data["teacher_action"][:, :, 6:].abs().max() > 0.05  # the gait moves the fingers
+    assert torch.equal(data["action"], torch.zeros_like(data["action"]))
+
+
+def test_teacher_settings_are_refused_before_simulating(tmp_path):
+    with pytest.raises(ValueError, match="is a gait for rotate_y-"):
+        C.check_teacher("allegro/rotate_y-", "rotate", "z+", "physx_cpu")
+    with pytest.raises(ValueError, match="physx_cpu"):
+        C.check_teacher("allegro/rotate_y-", "rotate", "y-", "physx_cuda")
+    with pytest.raises(FileNotFoundError, match="gait not found"):
+        C.check_teacher("allegro/rotate_q", "rotate", "y-", "physx_cpu")
+    from unicross.rl.ppo import PPOTrainer
+    with pytest.raises(ValueError, match="needs collector.teacher"):
+        PPOTrainer(tmp_path / "r", skill="rotate", axis="y-", overrides={"loss": {"teacher_coef": 1.0}})
+    assert not (tmp_path / "r" / "checkpoint.pt").exists()

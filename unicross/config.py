@@ -79,7 +79,7 @@ RANGES = {
     "ppo": {"collector.total_frames": (1, True), "collector.frames_per_batch": (1, True),
             "collector.horizon": (1, True), "collector.noise_correlation": (0, True), "env.num_envs": (1, True), "env.object_limit": (1, True),
             "env.reconfiguration_freq": (0, True), "gae.gamma": (0, True), "gae.lmbda": (0, True),
-            "gae.reward_scale": (0, False), "optim.lr": (0, False), "optim.lr_min": (0, False),
+            "gae.reward_scale": (0, False), "loss.teacher_coef": (0, True), "loss.teacher_decay": (0, False), "optim.lr": (0, False), "optim.lr_min": (0, False),
             "optim.lr_max": (0, False), "optim.mini_epochs": (1, True), "optim.minibatch_size": (1, True),
             "logging.checkpoint_every": (1, True)},
     "dagger": {"optim.epochs": (1, True), "optim.lr": (0, False), "optim.batch_size": (1, True),

@@ -8,7 +8,8 @@ dict it returns. So the update can be tested on synthetic TensorDicts without a 
 
 A batch is a TensorDict ``[..., T]`` with the collector's keys: ``hand``, ``object``, ``goal``,
 ``action``, ``action_log_prob``, ``loc``, ``scale`` and ``next`` (``hand``, ``object``, ``goal``,
-``reward``, ``done``, ``terminated``, ``truncated``).
+``reward``, ``done``, ``terminated``, ``truncated``); with a teacher, ``teacher_action`` too
+(see :meth:`PPO.teacher_coef`).
 """
 from __future__ import annotations
 
@@ -24,7 +25,7 @@ from torchrl.objectives.value import GAE
 from unicross.rl.models import OBS_KEYS, make_models
 
 LOSS_KEYS = ("loss_objective", "loss_critic", "entropy", "kl_approx", "clip_fraction", "ESS",
-             "explained_variance", "value_clip_fraction")
+             "explained_variance", "value_clip_fraction", "loss_teacher")
 
 
 class PPO:
@@ -143,6 +144,7 @@ class PPO:
         out["lr"] = self.lr
         out["minibatch_steps"] = count
         out["critic_only"] = float(critic_only)
+        out["teacher_coef"] = 0.0 if critic_only else self.teacher_coef
         self.updates += 1
         out["value_mean"], out["value_std"] = float(vn.mean), float(vn.std())
         return out
@@ -160,6 +162,10 @@ class PPO:
             loss = loss + losses["loss_objective"]
             if "loss_entropy" in losses.keys():
                 loss = loss + losses["loss_entropy"]
+            coef = self.teacher_coef
+            if coef > 0.0:
+                losses["loss_teacher"] = self._teacher_loss(mb)
+                loss = loss + coef * losses["loss_teacher"]
         self.optim.zero_grad(set_to_none=True)
         loss.backward()
         ga = torch.nn.utils.clip_grad_norm_(self._actor_params, oc["max_grad_norm"])
@@ -174,6 +180,21 @@ class PPO:
         stats["grad_norm_actor"] += float(ga)
         stats["grad_norm_critic"] += float(gc)
         return klv
+
+    @property
+    def teacher_coef(self) -> float:
+        """The weight of the teacher term in this update: ``loss.teacher_coef`` x
+        ``loss.teacher_decay`` ** (actor updates so far). The term is the mean squared distance of the
+        actor's mean action to ``teacher_action`` on the minibatch's own states, added to the PPO
+        loss (kickstarting, Schmitt et al. 2018: the teacher labels the student's states, and its
+        weight decays so that PPO's return takes over; cf. DAPG's decaying demonstration term)."""
+        lc = self.cfg["loss"]
+        k = max(0, self.updates - int(self.cfg["optim"].get("critic_warmup") or 0))
+        return float(lc.get("teacher_coef", 0.0)) * float(lc.get("teacher_decay", 1.0)) ** k
+
+    def _teacher_loss(self, mb: TensorDict) -> torch.Tensor:
+        loc, _ = self.actor(*(mb[k] for k in OBS_KEYS))
+        return torch.nn.functional.mse_loss(loc, mb["teacher_action"])
 
     def _schedule_lr(self, kl: float) -> None:
         """``optim.schedule``: ``fixed``, or ``adaptive`` (rl_games): the rate shrinks by 1.5 when

@@ -16,7 +16,9 @@ Batch layout (what TorchRL's GAE and ``ClipPPOLoss`` read), ``[num_envs, T]``: `
 ``action_log_prob``, ``loc``, ``scale``, and under ``next``: the observation after the step (the
 last one of an episode, before the reset), ``reward``, ``done``, ``terminated`` (object dropped),
 ``truncated`` (episode length), and ``info`` (the task's per-term rewards and flags,
-:func:`unicross.rl.env.info_float_keys` / ``INFO_BOOL``).
+:func:`unicross.rl.env.info_float_keys` / ``INFO_BOOL``). With a teacher (``collector.teacher``),
+also ``teacher_action``: the teacher's action in the state the policy acted in (kickstarting's
+label, Schmitt et al. 2018; :class:`unicross.rl.algorithm.PPO` fits the actor's mean to it).
 """
 from __future__ import annotations
 
@@ -39,8 +41,9 @@ from unicross.rl.env import INFO_BOOL, info_float_keys, split_obs
 OBS_KEYS = ("hand", "object", "goal")
 
 
-def make_buffer(n: int, horizon: int, dims: dict, n_act: int, device="cpu") -> TensorDict:
-    """Zeroed rollout storage ``[n, horizon]`` with the keys of the module docstring."""
+def make_buffer(n: int, horizon: int, dims: dict, n_act: int, device="cpu", teacher: bool = False) -> TensorDict:
+    """Zeroed rollout storage ``[n, horizon]`` with the keys of the module docstring (``teacher``:
+    with ``teacher_action``)."""
     b = (n, horizon)
     z = lambda *s, dtype=torch.float32: torch.zeros(b + s, dtype=dtype, device=device)  # noqa: E731
     obs = {k: z(dims[k]) for k in OBS_KEYS}
@@ -48,8 +51,40 @@ def make_buffer(n: int, horizon: int, dims: dict, n_act: int, device="cpu") -> T
     nxt = {k: z(dims[k]) for k in OBS_KEYS} | dict(
         reward=z(1), done=z(1, dtype=torch.bool), terminated=z(1, dtype=torch.bool),
         truncated=z(1, dtype=torch.bool), info=TensorDict(info, batch_size=b, device=device))
+    extra = {"teacher_action": z(n_act)} if teacher else {}
     return TensorDict({**obs, "action": z(n_act), "action_log_prob": z(), "loc": z(n_act), "scale": z(n_act),
-                       "next": TensorDict(nxt, batch_size=b, device=device)}, batch_size=b, device=device)
+                       **extra, "next": TensorDict(nxt, batch_size=b, device=device)}, batch_size=b, device=device)
+
+
+def make_teacher(spec: Optional[str]):
+    """``collector.teacher``: None, or a scripted gait (a shipped ``<hand>/<mode>`` such as
+    ``allegro/rotate_y-``, or a gait search log) as a function ``task -> action``. A gait reads the
+    task's state and keeps one clock for its envs, so it must see every step, and its envs must
+    start their episodes together (one env per CPU worker; :func:`check_teacher`)."""
+    if spec is None:
+        return None
+    from unicross.gaits import make_gait_policy
+    gait = make_gait_policy(spec)
+    return lambda task: gait(None, task)
+
+
+def check_teacher(spec: Optional[str], skill: str, axis: Optional[str], backend: str,
+                  ray_address: Optional[str] = None) -> None:
+    """Refuses (before any simulation) a ``collector.teacher`` that is not a gait of this run's mode,
+    or one on the GPU backend (its sub-scenes reset one by one; a gait keeps one clock) or with Ray
+    env actors (which do not carry it)."""
+    if spec is None:
+        return
+    if ray_address:
+        raise ValueError("collector.teacher is not supported with collector.ray_address (Ray env actors)")
+    if backend != "physx_cpu":
+        raise ValueError("collector.teacher (a scripted gait) needs env.backend physx_cpu: a gait keeps one clock "
+                         "for all its envs, and GPU sub-scenes reset one by one")
+    from unicross.gaits import best_gait, gait_mode, resolve_gait
+    mode = gait_mode(best_gait(resolve_gait(spec))[1])
+    ours = f"{skill}_{axis}" if axis else skill
+    if mode != ours:
+        raise ValueError(f"collector.teacher={spec} is a gait for {mode}, this run trains {ours}")
 
 
 class Rollout:
@@ -64,10 +99,12 @@ class Rollout:
     log-probability is that marginal's, as PPO's ratio reads it (temporally correlated "coloured"
     noise in PPO, Hollenstein et al. 2024). ρ = 0: white noise. Residual finger targets integrate
     the actions, so correlated noise moves them ~sqrt((1 + ρ)/(1 - ρ)) times farther per episode
-    (4.4x at 0.9) at the same per-step spread."""
+    (4.4x at 0.9) at the same per-step spread.
+
+    ``teacher`` (:func:`make_teacher`): its action in every state is written to ``teacher_action``."""
 
     def __init__(self, env_id: str, env_kwargs: dict, seed: int, deterministic: bool = False,
-                 noise_correlation: float = 0.0):
+                 noise_correlation: float = 0.0, teacher: Optional[str] = None):
         import gymnasium as gym
         import unicross  # noqa: F401  (registers the tasks)
         kw = dict(render_backend="none", **env_kwargs)
@@ -81,6 +118,7 @@ class Rollout:
         self.gen.manual_seed(seed)
         self.rho = float(noise_correlation)
         self.eps: Optional[torch.Tensor] = None  # the AR(1) noise state (rho > 0)
+        self.teacher = make_teacher(teacher)
         obs, _ = self.task.reset(seed=seed)
         self.obs = split_obs(obs)
         self.dims = {k: x.shape[-1] for k, x in zip(OBS_KEYS, self.obs)}
@@ -100,9 +138,12 @@ class Rollout:
         rew, done_b = leaves[("next", "reward")], leaves[("next", "done")]
         term_b, trunc_b = leaves[("next", "terminated")], leaves[("next", "truncated")]
         half_log_2pi = 0.5 * math.log(2 * math.pi)
+        teacher_b = leaves.get("teacher_action") if self.teacher is not None else None
         for t in range(buf.shape[1]):
             for dst, x in zip(obs_buf, self.obs):
                 dst[:, t] = x
+            if teacher_b is not None:
+                teacher_b[:, t] = self.teacher(self.task)
             loc, scale = self.actor(*self.obs)
             noise = torch.zeros_like(loc) if self.deterministic else self._noise(loc.shape)
             a = loc + scale * noise
@@ -141,13 +182,13 @@ class Rollout:
 
 
 def _worker(rank: int, env_id: str, env_kwargs: dict, seed: int, deterministic: bool, noise_correlation: float,
-            conn) -> None:
+            teacher: Optional[str], conn) -> None:
     """Worker process: one env. Reports its sizes, receives the shared actor and buffer, then
     fills row ``rank`` of the buffer on every "collect"."""
     torch.set_num_threads(1)
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C reaches the whole group; the main process stops us
     try:
-        rollout = Rollout(env_id, env_kwargs, seed, deterministic, noise_correlation)
+        rollout = Rollout(env_id, env_kwargs, seed, deterministic, noise_correlation, teacher)
         conn.send(("ready", (rollout.dims, rollout.n_act)))
         msg, (actor, buf) = conn.recv()
         rollout.set_actor(actor)
@@ -238,14 +279,16 @@ class LeanCollector:
     backend: in the main process. Env ``i`` starts from a reset seeded with ``seed + i`` and draws
     its action noise from a generator seeded likewise (``deterministic``: the mean action, as
     DAgger's student acts; the stored log-probability is then that of the mean), AR(1) in time with
-    ``noise_correlation`` (see :class:`Rollout`). The envs are built first (``dims``,
+    ``noise_correlation`` (see :class:`Rollout`); ``teacher``: a gait labelling every state
+    (:func:`make_teacher`). The envs are built first (``dims``,
     ``n_act`` come from them); :meth:`set_actor` then hands them the actor, whose tensors are moved
     to shared memory, so the optimiser's in-place steps and the statistics updates reach the workers.
     """
 
     def __init__(self, env_id: str, env_kwargs: dict, num_envs: int, horizon: int, seed: int = 0,
-                 backend: str = "physx_cpu", deterministic: bool = False, noise_correlation: float = 0.0):
-        self.horizon, self.num_envs = horizon, num_envs
+                 backend: str = "physx_cpu", deterministic: bool = False, noise_correlation: float = 0.0,
+                 teacher: Optional[str] = None):
+        self.horizon, self.num_envs, self.teacher = horizon, num_envs, teacher is not None
         kw = dict(env_kwargs)
         self._procs, self._conns, self._local, self.buf = [], [], None, None
         if backend == "physx_cuda":
@@ -253,13 +296,14 @@ class LeanCollector:
         else:
             kw.update(sim_backend="physx_cpu", num_envs=1)
         if backend == "physx_cuda" or num_envs == 1:
-            self._local = Rollout(env_id, kw, seed, deterministic, noise_correlation)
+            self._local = Rollout(env_id, kw, seed, deterministic, noise_correlation, teacher)
             self.dims, self.n_act, self.device = self._local.dims, self._local.n_act, self._local.device
             return
         ctx = mp.get_context("spawn")
         for rank in range(num_envs):
             parent, child = ctx.Pipe()
-            p = ctx.Process(target=_worker, args=(rank, env_id, kw, seed + rank, deterministic, noise_correlation, child), daemon=True,
+            p = ctx.Process(target=_worker, args=(rank, env_id, kw, seed + rank, deterministic, noise_correlation, teacher,
+                                                          child), daemon=True,
                             name=f"unicross-env-{rank}")
             p.start()
             self._procs.append(p)
@@ -275,10 +319,10 @@ class LeanCollector:
         """The module ``(hand, object, goal) -> (loc, scale)`` the envs act with."""
         if self._local is not None:
             self._local.set_actor(actor)
-            self.buf = make_buffer(self.num_envs, self.horizon, self.dims, self.n_act, self.device)
+            self.buf = make_buffer(self.num_envs, self.horizon, self.dims, self.n_act, self.device, self.teacher)
             return
         actor.share_memory()
-        self.buf = make_buffer(self.num_envs, self.horizon, self.dims, self.n_act).share_memory_()
+        self.buf = make_buffer(self.num_envs, self.horizon, self.dims, self.n_act, teacher=self.teacher).share_memory_()
         for conn in self._conns:
             conn.send(("setup", (actor, self.buf)))
         self._wait("ready")
@@ -363,7 +407,8 @@ def resolve_num_envs(num_envs, backend: str, ray_address: Optional[str] = None) 
 
 
 def make_collector(env_id: str, env_kwargs: dict, num_envs: int, horizon: int, seed: int, backend: str,
-                   ray_address: Optional[str] = None, deterministic: bool = False, noise_correlation: float = 0.0):
+                   ray_address: Optional[str] = None, deterministic: bool = False, noise_correlation: float = 0.0,
+                   teacher: Optional[str] = None):
     """The collector of a trainer: Ray env actors when ``ray_address`` is set (see
     :func:`resolve_num_envs`, which connects), else :class:`LeanCollector`."""
     if not 0.0 <= noise_correlation < 1.0:
@@ -373,4 +418,4 @@ def make_collector(env_id: str, env_kwargs: dict, num_envs: int, horizon: int, s
         return RayCollector(env_id, env_kwargs, num_envs, horizon, seed=seed, address=ray_address,
                             deterministic=deterministic, noise_correlation=noise_correlation)
     return LeanCollector(env_id, env_kwargs, num_envs, horizon, seed=seed, backend=backend,
-                         deterministic=deterministic, noise_correlation=noise_correlation)
+                         deterministic=deterministic, noise_correlation=noise_correlation, teacher=teacher)

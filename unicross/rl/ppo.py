@@ -25,7 +25,7 @@ from unicross import formulation as F
 from unicross import registry as R
 from unicross.rewards import term_names
 from unicross.rl.algorithm import PPO
-from unicross.rl.collector import make_collector, resolve_num_envs
+from unicross.rl.collector import check_teacher, make_collector, resolve_num_envs
 from unicross.rl.models import OBS_KEYS  # noqa: F401  (re-exported for benchmarks)
 from unicross.rl.runner import CKPT_NAME, Runner, atomic_save, git_commit, open_run  # noqa: F401  (re-exported)
 
@@ -130,6 +130,10 @@ class PPOTrainer(Runner):
         self.env_id = R.skill(skill).env_id
         self.env_kwargs = env_kwargs_for(skill, axis, hand, cfg["env"])
         ec = cfg["env"]
+        teacher = cfg["collector"].get("teacher")
+        check_teacher(teacher, skill, axis, ec["backend"], cfg["collector"].get("ray_address"))
+        if float(cfg["loss"].get("teacher_coef", 0.0)) > 0.0 and teacher is None:
+            raise ValueError("loss.teacher_coef > 0 needs collector.teacher (e.g. allegro/rotate_y-)")
         self.share_cores(ec["backend"])
         num_envs = resolve_num_envs(ec["num_envs"], ec["backend"], cfg["collector"].get("ray_address"))
         self.horizon = resolve_horizon(cfg["collector"], skill, num_envs)
@@ -137,7 +141,8 @@ class PPOTrainer(Runner):
         seed = cfg["seed"] + 1000 * int((self.ckpt or {}).get("iteration", 0))
         self.collector = make_collector(self.env_id, self.env_kwargs, num_envs, self.horizon, seed, ec["backend"],
                                         cfg["collector"].get("ray_address"),
-                                        noise_correlation=float(cfg["collector"].get("noise_correlation", 0.0)))
+                                        noise_correlation=float(cfg["collector"].get("noise_correlation", 0.0)),
+                                        teacher=teacher)
         self.device = self.collector.device
         dims, self.n_act = self.collector.dims, self.collector.n_act
         self.algo = PPO(dims, self.n_act, cfg, self.collector.frames_per_batch, self.device)
