@@ -8,7 +8,9 @@ s^h, s^o and g. This script labels states with the gait and fits the network to 
 out (its mean action) and the gait labels the states the network visits (the gait's label is a
 step toward its own trajectory from the current joint command, and its stop follows the object's
 actual rotation, so it is defined on any state); the network is refitted on everything gathered
-(MSE on the action mean, the observation normaliser fitted to the data); the network kept is the
+(MSE on the action mean, the observation normaliser fitted to the data; ``fresh_mse`` in the log is
+the network's error on a round's new states before it is refitted on them, i.e. on states it has not
+been fitted to, and ``mse`` its error on all the data after the refit); the network kept is the
 one whose own rollouts succeeded most often (with ``--beta``, DAgger's mixture: in round r the
 gait takes over a fraction beta**r of the network's steps, and only the last round, the network
 alone, selects). Rollouts run the rotate
@@ -37,7 +39,7 @@ from unicross import formulation as F
 
 
 def _rollouts(gait: str, hand: str, objects: str, limit: int, trials: int, seed: int, randomize: bool,
-              student, shard, beta: float = 0.0) -> tuple:
+              student, shard, beta: float = 0.0, tracking: str = "clock", lookahead: float = 1.0) -> tuple:
     """One worker's share: (obs dict of [N, d], labels [N, A], trials) of the rotate protocol on its
     objects, the gait acting (``student`` None) or the student's mean acting while the gait labels;
     with ``beta`` > 0 the gait's own action is taken instead at that fraction of the steps (each env
@@ -49,7 +51,7 @@ def _rollouts(gait: str, hand: str, objects: str, limit: int, trials: int, seed:
     from unicross.objects import get_object_set
     from unicross.rl.env import split_obs
     from unicross.rl.policy_io import actor_action
-    teacher = make_gait_policy(gait)
+    teacher = make_gait_policy(gait, tracking=tracking, lookahead=lookahead)
     axis = gait_mode(best_gait(resolve_gait(gait))[1]).split("_")[1]
     keys = ("hand", "object", "goal")
     rows = {k: [] for k in keys}
@@ -85,8 +87,12 @@ def main(argv=None) -> int:
     ap.add_argument("--epochs", type=int, default=30, help="passes over the aggregated data after each round")
     ap.add_argument("--batch", type=int, default=512)
     ap.add_argument("--lr", type=float, default=1e-3)
+    ap.add_argument("--weight-decay", type=float, default=0.0, help="AdamW's decoupled weight decay (0: Adam)")
     ap.add_argument("--beta", type=float, default=0.0,
                     help="DAgger's mixture: in round r the gait acts at beta**r of the network's steps (0: never)")
+    ap.add_argument("--tracking", default="clock", choices=("clock", "phase"),
+                    help="the gait's target: by its clock, or ahead of the nearest point of its cycle (unicross.gaits)")
+    ap.add_argument("--lookahead", type=float, default=1.0, help="--tracking phase: steps ahead of the nearest point")
     ap.add_argument("--randomize", action="store_true", help="training's randomisation (default: the evaluation's conditions)")
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--seed", type=int, default=0)
@@ -123,7 +129,7 @@ def main(argv=None) -> int:
         with ProcessPoolExecutor(args.workers, mp_context=ctx) as ex:
             parts = [f.result() for f in [ex.submit(_rollouts, args.gait, args.hand, args.objects, args.limit,
                                                      args.trials, args.seed + 7919 * r, args.randomize, student,
-                                                     (i, args.workers), beta_of(r))
+                                                     (i, args.workers), beta_of(r), args.tracking, args.lookahead)
                                            for i in range(args.workers)]]
         o = {k: torch.cat([p[0][k] for p in parts]) for k in parts[0][0]}
         y = torch.cat([p[1] for p in parts])
@@ -133,6 +139,10 @@ def main(argv=None) -> int:
         who = "gait" if r == 0 else ("network" if beta_of(r) == 0 else f"network, gait at {beta_of(r):.3g} of steps")
         row = dict(round=r, actor=who, episodes=len(trials), success=sr, dropped=drops, new_states=len(y),
                    wall_s=round(time.time() - t0, 1))
+        if actor is not None:  # the network's error on states it was not fitted to (before it sees them)
+            with torch.no_grad():
+                loc, _ = actor(o["hand"], o["object"], o["goal"])
+                row["fresh_mse"] = float(torch.nn.functional.mse_loss(loc.clamp(-1, 1), y))
         if r > 0 and beta_of(r) == 0:  # only rollouts of the network alone select it
             fitted[r]["success"] = sr
         if r == args.rounds:  # the last round only measures the final network
@@ -151,7 +161,7 @@ def main(argv=None) -> int:
                 getattr(norm, f"{k}_var").fill_(1.0)
             norm.count.fill_(1e-4)
         norm.update(obs)
-        opt = torch.optim.Adam(actor.net.parameters(), lr=args.lr)
+        opt = torch.optim.AdamW(actor.net.parameters(), lr=args.lr, weight_decay=args.weight_decay)
         n = len(labels)
         for _ in range(args.epochs):
             perm = torch.randperm(n)

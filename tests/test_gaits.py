@@ -91,3 +91,31 @@ def test_a_gait_is_evaluated_on_its_own_mode_only(tmp_path, capsys):
                      "--out", str(tmp_path / "ev")]) != 0
         assert "is a gait for rotate_y-: evaluate it with --protocol rotate --axis y-" in capsys.readouterr().err
     assert not (tmp_path / "ev").exists()
+
+
+def test_phase_tracking_follows_the_cycle_from_wherever_the_fingers_are(tmp_path):
+    """``tracking="phase"``: the target is ``lookahead`` steps past the point of the cycle nearest
+    the command. A hand on the cycle at step t is sent to the clock's target of step t + lookahead,
+    whatever the env's clock says (a clock gait would send it back to its own step); the action
+    depends on the command, not on the clock; wrong settings are refused."""
+    from unicross.gaits import gait_offsets
+    g = torch.Generator().manual_seed(1)
+    p = (torch.rand(NPAR, generator=g) * 2 - 1).tolist()
+    p[24] = -1.0  # a period of 6 control steps: grid points at whole and half steps
+    _write(tmp_path / "log.jsonl", [dict(meta=dict(amplitude=1.0), p=p, score=1.0)])
+    policy = make_gait_policy(str(tmp_path / "log.jsonl"), tracking="phase", lookahead=1.0, grid=2)
+    clock = make_gait_policy(str(tmp_path / "log.jsonl"))
+    u = _stand_in_env(1, "rotate_y-", [0.0, -1.0, 0.0])
+    u.action_scale = torch.full((22,), 10.0)  # no clamp: the action is the whole move to the target
+    q0 = u.command[:, 6:].clone()
+    policy(None, u)  # step 0 fixes q0
+    clock(None, u)
+    for t_hand, t_clock in ((2, 5), (3.5, 1)):
+        u.command[:, 6:] = q0 + gait_offsets(p, torch.tensor(t_hand))
+        u.elapsed_steps[:] = t_clock
+        move = policy(None, u)[:, 6:] * 10.0
+        want = gait_offsets(p, torch.tensor(t_hand + 1.0)) - gait_offsets(p, torch.tensor(t_hand))
+        torch.testing.assert_close(move[0], want, atol=1e-5, rtol=0)
+        assert not torch.allclose(clock(None, u)[:, 6:] * 10.0, move, atol=1e-3)  # the clock's target differs
+    with pytest.raises(ValueError, match="tracking"):
+        make_gait_policy(str(tmp_path / "log.jsonl"), tracking="nearest")

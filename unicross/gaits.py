@@ -103,10 +103,47 @@ def gait_mode(row: dict) -> str:
     return f"{meta.get('skill', 'rotate')}_{meta['refine']}"
 
 
-def make_gait_policy(spec: str):
+def gait_offsets(p, t: torch.Tensor) -> torch.Tensor:
+    """:func:`gait_targets` minus q0, batched over the (fractional) control steps ``t`` [...] -> [..., 16]."""
+    period = 6 + 30 * (float(p[24]) + 1) / 2
+    t = torch.as_tensor(t, dtype=torch.float32)
+    off = torch.zeros(t.shape + (16,), device=t.device)
+    for f in range(4):
+        a_abd, a_mcp, a_dis, ph, loop, bias = (float(v) for v in p[6 * f: 6 * f + 6])
+        th = 2 * math.pi * t / period + math.pi * ph
+        j = 4 * f
+        off[..., j] = 0.3 * a_abd * torch.sin(th)
+        off[..., j + 1] = 0.5 * a_mcp * torch.sin(th) + 0.2 * bias
+        d = 0.5 * a_dis * torch.sin(th + math.pi * loop) + 0.2 * bias
+        off[..., j + 2] = d
+        off[..., j + 3] = d
+    return off
+
+
+TRACKING = ("clock", "phase")
+
+
+def make_gait_policy(spec: str, tracking: str = "clock", lookahead: float = 1.0, grid: int = 8):
     """The scripted in-hand policy of the best gait in ``spec`` (a log, or a shipped gait's
-    ``<hand>/<mode>``; see the module docstring)."""
+    ``<hand>/<mode>``; see the module docstring).
+
+    ``tracking``: how the gait's target is chosen at each step.
+
+    - ``clock`` (the gait as searched): the target of the control step, whatever the fingers did;
+      a hand that lags behind it (the per-step move is clamped) is pulled toward a target that
+      runs ahead on the clock, which the observation does not show.
+    - ``phase``: the target ``lookahead`` steps ahead of the point of the gait's cycle nearest the
+      current joint command (the cycle sampled ``grid`` times per control step): the gait as an
+      autonomous limit cycle, whose action depends on the command and the start command q0 only,
+      not on a clock. Labels of this kind are a function of what a policy can observe (up to q0,
+      fixed per episode), so a network can fit them on states it has not seen.
+    """
+    if tracking not in TRACKING:
+        raise ValueError(f"gait tracking must be one of {TRACKING}, got {tracking!r}")
     p, row = best_gait(resolve_gait(spec))
+    period = 6 + 30 * (float(p[24]) + 1) / 2
+    taus = torch.arange(int(math.ceil(period * grid))) / grid
+    cycle = gait_offsets(p, taus[taus < period])  # [K, 16] offsets over one period
     state = {}
 
     def policy(obs, u):
@@ -126,7 +163,13 @@ def make_gait_policy(spec: str):
             state["motion"] += (vel * u.axis).sum(-1) * u.control_dt
         state["done"] |= state["motion"] > state["threshold"]
         a = torch.zeros(u.num_envs, u.hand_spec.dof, device=u.device)
-        step = ((gait_targets(p, t + 1, state["q0"]) - u.command[:, 6:]) / u.action_scale[6:]).clamp(-1, 1)
+        if tracking == "clock":
+            target = gait_targets(p, t + 1, state["q0"])
+        else:
+            rel = u.command[:, 6:] - state["q0"]  # [N, 16]
+            k = ((cycle.to(u.device)[None] - rel[:, None]) ** 2).sum(-1).argmin(1)  # [N]
+            target = state["q0"] + gait_offsets(p, taus.to(u.device)[k] + lookahead)
+        step = ((target - u.command[:, 6:]) / u.action_scale[6:]).clamp(-1, 1)
         a[:, 6:] = torch.where(state["done"][:, None], torch.zeros_like(step), step)
         return a
     policy.gait_row = row
