@@ -39,7 +39,7 @@ from unicross import formulation as F
 
 
 def _rollouts(gait: str, hand: str, objects: str, limit: int, trials: int, seed: int, randomize: bool,
-              student, shard, beta: float = 0.0, tracking: str = "clock", lookahead: float = 1.0) -> tuple:
+              student, shard, beta: float = 0.0, privileged_q0: bool = False) -> tuple:
     """One worker's share: (obs dict of [N, d], labels [N, A], trials) of the rotate protocol on its
     objects, the gait acting (``student`` None) or the student's mean acting while the gait labels;
     with ``beta`` > 0 the gait's own action is taken instead at that fraction of the steps (each env
@@ -47,25 +47,31 @@ def _rollouts(gait: str, hand: str, objects: str, limit: int, trials: int, seed:
     torch.set_num_threads(1)
     import unicross  # noqa: F401  (registers the tasks)
     from unicross import evaluation as E
-    from unicross.gaits import best_gait, gait_mode, make_gait_policy, resolve_gait
+    from unicross.gaits import gait_mode, make_gait_policy
     from unicross.objects import get_object_set
     from unicross.rl.env import split_obs
-    from unicross.rl.policy_io import actor_action
-    teacher = make_gait_policy(gait, tracking=tracking, lookahead=lookahead)
-    axis = gait_mode(best_gait(resolve_gait(gait))[1]).split("_")[1]
+    teacher = make_gait_policy(gait)
+    axis = gait_mode(teacher.gait_row).split("_")[1]
     keys = ("hand", "object", "goal")
     rows = {k: [] for k in keys}
     labels = []
     mix = torch.Generator().manual_seed(seed + 104729 * shard[0])
 
+    q0 = {}
+
     def policy(obs, u):
         label = teacher(obs, u)
-        for k, x in zip(keys, split_obs(obs)):
+        parts = split_obs(obs)
+        if privileged_q0:  # diagnosis only: the episode's start command appended to the hand state
+            if int(u.elapsed_steps[0]) == 0:
+                q0["q"] = u.command[:, 6:].clone()
+            parts = (torch.cat([parts[0], q0["q"]], -1),) + tuple(parts[1:])
+        for k, x in zip(keys, parts):
             rows[k].append(x.clone())
         labels.append(label.clone())
         if student is None:
             return label
-        act = actor_action(student, obs)
+        act = student(*parts)[0].clamp(-1.0, 1.0)
         if beta > 0:
             gait_steps = torch.rand(act.shape[0], 1, generator=mix) < beta
             act = torch.where(gait_steps, label, act)
@@ -78,7 +84,8 @@ def _rollouts(gait: str, hand: str, objects: str, limit: int, trials: int, seed:
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--gait", required=True, help="a shipped gait (allegro/rotate_y-) or a gait_search log")
+    ap.add_argument("--gait", required=True, help="a shipped gait (allegro/rotate_y-) or a gait_search log, with "
+                    "options after commas (allegro/rotate_y-,tracking=phase,lookahead=1.5: unicross.gaits)")
     ap.add_argument("--hand", default="allegro")
     ap.add_argument("--objects", default="train")
     ap.add_argument("--limit", type=int, default=8, help="first N objects per group of --objects")
@@ -90,9 +97,9 @@ def main(argv=None) -> int:
     ap.add_argument("--weight-decay", type=float, default=0.0, help="AdamW's decoupled weight decay (0: Adam)")
     ap.add_argument("--beta", type=float, default=0.0,
                     help="DAgger's mixture: in round r the gait acts at beta**r of the network's steps (0: never)")
-    ap.add_argument("--tracking", default="clock", choices=("clock", "phase"),
-                    help="the gait's target: by its clock, or ahead of the nearest point of its cycle (unicross.gaits)")
-    ap.add_argument("--lookahead", type=float, default=1.0, help="--tracking phase: steps ahead of the nearest point")
+    ap.add_argument("--privileged-q0", action="store_true",
+                    help="diagnosis only: the network also sees the episode's start command (the gait's centre); "
+                         "its checkpoint does not fit the UniCross observation and is not written")
     ap.add_argument("--randomize", action="store_true", help="training's randomisation (default: the evaluation's conditions)")
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--seed", type=int, default=0)
@@ -101,12 +108,12 @@ def main(argv=None) -> int:
 
     import unicross  # noqa: F401
     from unicross.config import load_config
-    from unicross.gaits import best_gait, gait_mode, resolve_gait
+    from unicross.gaits import gait_mode, make_gait_policy
     from unicross.rl.models import make_models
     from unicross.rl.ppo import env_kwargs_for
     from unicross.rl.runner import git_commit
     from unicross import registry as R
-    mode = gait_mode(best_gait(resolve_gait(args.gait))[1])  # fails before any simulation
+    mode = gait_mode(make_gait_policy(args.gait).gait_row)  # a bad gait or option fails before any simulation
     skill, axis = mode.split("_")
     cfg = load_config("ppo")
     out = Path(args.out)
@@ -129,7 +136,7 @@ def main(argv=None) -> int:
         with ProcessPoolExecutor(args.workers, mp_context=ctx) as ex:
             parts = [f.result() for f in [ex.submit(_rollouts, args.gait, args.hand, args.objects, args.limit,
                                                      args.trials, args.seed + 7919 * r, args.randomize, student,
-                                                     (i, args.workers), beta_of(r), args.tracking, args.lookahead)
+                                                     (i, args.workers), beta_of(r), args.privileged_q0)
                                            for i in range(args.workers)]]
         o = {k: torch.cat([p[0][k] for p in parts]) for k in parts[0][0]}
         y = torch.cat([p[1] for p in parts])
@@ -189,12 +196,14 @@ def main(argv=None) -> int:
               skill=skill, axis=axis, hand=args.hand, env_id=R.skill(skill).env_id,
               env_kwargs=env_kwargs_for(skill, axis, args.hand, cfg["env"]), iteration=0, frames=0,
               git_commit=git_commit(), commits=[git_commit()])
-    torch.save(ck, out / "policy.pt")
+    if not args.privileged_q0:
+        torch.save(ck, out / "policy.pt")
     with open(out / "log.jsonl", "w") as f:
         f.writelines(json.dumps(x) + "\n" for x in log)
     (out / "command.txt").write_text("python benchmarks/gait_clone.py " + " ".join(sys.argv[1:] if argv is None else argv)
                                      + f"  # commit {git_commit()}\n")
-    print(f"wrote {out / 'policy.pt'}: the network of round {best} ({100 * fitted[best]['success']:.1f}% "
+    what = "(not written: --privileged-q0)" if args.privileged_q0 else f"wrote {out / 'policy.pt'}:"
+    print(f"{what} the network of round {best} ({100 * fitted[best]['success']:.1f}% "
           f"of its episodes; {time.time() - t0:.0f} s)")
     return 0
 

@@ -119,3 +119,23 @@ def test_phase_tracking_follows_the_cycle_from_wherever_the_fingers_are(tmp_path
         assert not torch.allclose(clock(None, u)[:, 6:] * 10.0, move, atol=1e-3)  # the clock's target differs
     with pytest.raises(ValueError, match="tracking"):
         make_gait_policy(str(tmp_path / "log.jsonl"), tracking="nearest")
+
+
+def test_gait_options_ride_in_the_spec(tmp_path):
+    """``GAIT,tracking=phase,lookahead=1.5``: what ``unicross eval --policy gait:...`` and
+    ``collector.teacher`` pass on; unknown keys and bad values are refused."""
+    from unicross.gaits import resolve_gait, split_gait_spec
+    assert split_gait_spec("allegro/rotate_y-,tracking=phase,lookahead=1.5,grid=4") == \
+        ("allegro/rotate_y-", dict(tracking="phase", lookahead=1.5, grid=4))
+    assert resolve_gait("allegro/rotate_y-,tracking=phase") == resolve_gait("allegro/rotate_y-")
+    for bad in ("allegro/rotate_y-,speed=2", "allegro/rotate_y-,lookahead=fast", "allegro/rotate_y-,tracking"):
+        with pytest.raises(ValueError, match="gait 'allegro/rotate_y-,"):
+            split_gait_spec(bad)
+    with pytest.raises(ValueError, match="tracking must be one of"):
+        make_gait_policy("allegro/rotate_y-,tracking=nearest")
+    u = _stand_in_env(1, "rotate_y-", [0.0, -1.0, 0.0])
+    u.command[:, 6:] = 0.3  # off the cycle: the two trackings pick different targets
+    u.elapsed_steps[:] = 0
+    phase = make_gait_policy("allegro/rotate_y-,tracking=phase,lookahead=1.5")(None, u)
+    assert torch.equal(phase, make_gait_policy("allegro/rotate_y-", tracking="phase", lookahead=1.5)(None, u))
+    assert not torch.equal(phase, make_gait_policy("allegro/rotate_y-")(None, u))

@@ -48,9 +48,30 @@ def gait_targets(p, t: int, q0: torch.Tensor) -> torch.Tensor:
 SHIPPED_DIR = Path(__file__).resolve().parent / "checkpoints"
 
 
+GAIT_OPTIONS = {"tracking": str, "lookahead": float, "grid": int}
+
+
+def split_gait_spec(spec: str) -> Tuple[str, dict]:
+    """(gait, options) of ``GAIT[,key=value...]``, the options of :func:`make_gait_policy`
+    (``tracking``, ``lookahead``, ``grid``), e.g. ``allegro/rotate_y-,tracking=phase,lookahead=1.5``."""
+    base, *rest = spec.split(",")
+    opts = {}
+    for kv in rest:
+        k, _, v = kv.partition("=")
+        if k not in GAIT_OPTIONS or not v:
+            raise ValueError(f"gait {spec!r}: options are key=value with key in {sorted(GAIT_OPTIONS)}, got {kv!r}")
+        try:
+            opts[k] = GAIT_OPTIONS[k](v)
+        except ValueError:
+            raise ValueError(f"gait {spec!r}: {k} must be a {GAIT_OPTIONS[k].__name__}, got {v!r}") from None
+    return base, opts
+
+
 def resolve_gait(spec: str) -> str:
     """A gait log path, or the shorthand ``<hand>/<mode>`` of a shipped gait
-    (``unicross/checkpoints/<hand>/gaits/<mode>.json``, e.g. ``allegro/rotate_y-``)."""
+    (``unicross/checkpoints/<hand>/gaits/<mode>.json``, e.g. ``allegro/rotate_y-``); options after a
+    comma (:func:`split_gait_spec`) are ignored here."""
+    spec = split_gait_spec(spec)[0]
     if Path(spec).exists() or spec.endswith((".json", ".jsonl", ".gz")):
         if not Path(spec).exists():
             raise FileNotFoundError(f"gait log not found: {spec}")
@@ -125,7 +146,9 @@ TRACKING = ("clock", "phase")
 
 def make_gait_policy(spec: str, tracking: str = "clock", lookahead: float = 1.0, grid: int = 8):
     """The scripted in-hand policy of the best gait in ``spec`` (a log, or a shipped gait's
-    ``<hand>/<mode>``; see the module docstring).
+    ``<hand>/<mode>``; see the module docstring). Options written into ``spec`` after commas
+    (``allegro/rotate_y-,tracking=phase,lookahead=1.5``; :func:`split_gait_spec`) override the
+    arguments, so ``unicross eval --policy gait:...`` and ``collector.teacher`` reach them.
 
     ``tracking``: how the gait's target is chosen at each step.
 
@@ -138,8 +161,12 @@ def make_gait_policy(spec: str, tracking: str = "clock", lookahead: float = 1.0,
       not on a clock. Labels of this kind are a function of what a policy can observe (up to q0,
       fixed per episode), so a network can fit them on states it has not seen.
     """
+    spec, opts = split_gait_spec(spec)
+    tracking, lookahead, grid = opts.get("tracking", tracking), opts.get("lookahead", lookahead), opts.get("grid", grid)
     if tracking not in TRACKING:
         raise ValueError(f"gait tracking must be one of {TRACKING}, got {tracking!r}")
+    if grid < 1:
+        raise ValueError(f"gait grid must be >= 1, got {grid}")
     p, row = best_gait(resolve_gait(spec))
     period = 6 + 30 * (float(p[24]) + 1) / 2
     taus = torch.arange(int(math.ceil(period * grid))) / grid

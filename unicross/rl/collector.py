@@ -80,8 +80,8 @@ def check_teacher(spec: Optional[str], skill: str, axis: Optional[str], backend:
     if backend != "physx_cpu":
         raise ValueError("collector.teacher (a scripted gait) needs env.backend physx_cpu: a gait keeps one clock "
                          "for all its envs, and GPU sub-scenes reset one by one")
-    from unicross.gaits import best_gait, gait_mode, resolve_gait
-    mode = gait_mode(best_gait(resolve_gait(spec))[1])
+    from unicross.gaits import gait_mode, make_gait_policy
+    mode = gait_mode(make_gait_policy(spec).gait_row)  # also checks the gait's options
     ours = f"{skill}_{axis}" if axis else skill
     if mode != ours:
         raise ValueError(f"collector.teacher={spec} is a gait for {mode}, this run trains {ours}")
