@@ -201,3 +201,11 @@ def test_frozen_config_refuses_writes_and_copies_are_plain():
         assert type(c) is dict and type(c["a"]) is dict and c == {"a": {"b": 1}, "c": [1, 2]}
         c["a"]["b"] = 5
     assert cfg["a"]["b"] == 1 and type(copy.copy(cfg)) is dict
+
+
+def test_an_evaluations_markdown_sits_beside_its_json_under_its_own_name():
+    from pathlib import Path
+    from unicross.cli import markdown_path
+    assert markdown_path(Path("d/e.json")) == Path("d/e.md")
+    assert markdown_path(Path("d/heldout")) == Path("d/heldout.md")
+    assert markdown_path(Path("d/lookahead1.5")) == Path("d/lookahead1.5.md")  # was d/lookahead1.md

@@ -364,8 +364,15 @@ def _cmd_eval(args) -> int:
         _write_eval(out, result)  # each finished protocol is on disk before the next starts
     table = _write_eval(out, result)
     print(table)
-    print(f"wrote {out} and {out.with_suffix('.md')}")
+    print(f"wrote {out} and {markdown_path(out)}")
     return 0
+
+
+def markdown_path(out: Path) -> Path:
+    """The markdown table beside an evaluation's JSON ``out``: ``e.json`` -> ``e.md``, ``heldout`` ->
+    ``heldout.md``, and ``lookahead1.5`` -> ``lookahead1.5.md`` (not ``lookahead1.md``, which
+    another run's table may own)."""
+    return out.with_suffix(".md") if out.suffix == ".json" else out.with_name(out.name + ".md")
 
 
 def _write_eval(out: Path, result: dict) -> str:
@@ -379,7 +386,7 @@ def _write_eval(out: Path, result: dict) -> str:
     except (FileExistsError, NotADirectoryError):
         raise ValueError(f"--out {out}: {out.parent} is not a directory") from None
     table = E.markdown_table({result["label"]: result["summaries"]}) if result["summaries"] else ""
-    for path, text in ((out, json.dumps(result, indent=1)), (out.with_suffix(".md"), table + "\n")):
+    for path, text in ((out, json.dumps(result, indent=1)), (markdown_path(out), table + "\n")):
         tmp = path.with_name(f"{path.name}.{os.getpid()}.tmp")
         try:
             tmp.write_text(text)
