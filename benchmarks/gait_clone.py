@@ -71,7 +71,8 @@ def _rollouts(gait: str, hand: str, objects: str, limit: int, trials: int, seed:
         labels.append(label.clone())
         if student is None:
             return label
-        act = student(*parts)[0].clamp(-1.0, 1.0)
+        with torch.no_grad():
+            act = student(*parts)[0].clamp(-1.0, 1.0)
         if beta > 0:
             gait_steps = torch.rand(act.shape[0], 1, generator=mix) < beta
             act = torch.where(gait_steps, label, act)

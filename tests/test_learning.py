@@ -287,3 +287,23 @@ def test_init_policy_starts_the_actor_from_a_policy_checkpoint(tmp_path):
         t.close()
     with pytest.raises(ValueError, match="this run trains"):
         PPOTrainer(tmp_path / "rot", "rotate", "x+", overrides=over, progress=False)
+
+
+@pytest.mark.slow
+def test_gait_clone_writes_a_policy_that_loads_and_logs_its_fresh_error(tmp_path):
+    """benchmarks/gait_clone.py end to end at its smallest (one object per group, one round): a
+    policy checkpoint the evaluation loads, and a log whose network round has ``fresh_mse``."""
+    import json
+    import subprocess
+    import sys
+    from pathlib import Path
+    from unicross.evaluation import resolve_policy
+    script = Path(__file__).resolve().parent.parent / "benchmarks" / "gait_clone.py"
+    out = tmp_path / "clone"
+    subprocess.run([sys.executable, str(script), "--gait", "allegro/rotate_y-,tracking=phase,lookahead=1.5",
+                    "--limit", "1", "--trials", "1", "--rounds", "1", "--workers", "1", "--out", str(out)],
+                   check=True, timeout=900)
+    rows = [json.loads(line) for line in (out / "log.jsonl").read_text().splitlines()]
+    assert rows[0]["actor"] == "gait" and rows[1]["actor"] == "network" and rows[1]["fresh_mse"] >= 0
+    _, desc = resolve_policy(str(out / "policy.pt"), "allegro")
+    assert desc["kind"] != "gait"
