@@ -29,20 +29,33 @@ NPAR = 6 * 4 + 1
 ROTATE_MODES = torch.tensor([F.mode_skill(m) == "rotate" for m in F.MODES])  # [modes]: rotation (else translation)
 
 
-def gait_targets(p, t: int, q0: torch.Tensor) -> torch.Tensor:
-    """Finger targets [..., 16] of gait ``p`` ([25] in [-1, 1]) at control step ``t`` around ``q0`` [..., 16]."""
-    period = 6 + 30 * (float(p[24]) + 1) / 2
-    q = q0.clone()
+def gait_period(p) -> float:
+    """The period of gait ``p`` in control steps (6..36)."""
+    return 6 + 30 * (float(p[24]) + 1) / 2
+
+
+def gait_offsets(p, t, dtype=torch.float32) -> torch.Tensor:
+    """The finger targets of gait ``p`` ([25] in [-1, 1]) minus q0, [..., 16], at the (fractional)
+    control steps ``t`` [...], computed in ``dtype`` and returned in float32."""
+    period = gait_period(p)
+    t = torch.as_tensor(t, dtype=dtype)
+    off = torch.zeros(t.shape + (16,), dtype=dtype, device=t.device)
     for f in range(4):
         a_abd, a_mcp, a_dis, ph, loop, bias = (float(v) for v in p[6 * f: 6 * f + 6])
         th = 2 * math.pi * t / period + math.pi * ph
         j = 4 * f
-        q[..., j] += 0.3 * a_abd * math.sin(th)
-        q[..., j + 1] += 0.5 * a_mcp * math.sin(th) + 0.2 * bias
-        d = 0.5 * a_dis * math.sin(th + math.pi * loop) + 0.2 * bias
-        q[..., j + 2] += d
-        q[..., j + 3] += d
-    return q
+        off[..., j] = 0.3 * a_abd * torch.sin(th)
+        off[..., j + 1] = 0.5 * a_mcp * torch.sin(th) + 0.2 * bias
+        d = 0.5 * a_dis * torch.sin(th + math.pi * loop) + 0.2 * bias
+        off[..., j + 2] = d
+        off[..., j + 3] = d
+    return off.float()
+
+
+def gait_targets(p, t: int, q0: torch.Tensor) -> torch.Tensor:
+    """Finger targets [..., 16] of gait ``p`` at control step ``t`` around ``q0`` [..., 16] (the
+    offsets in float64, as the searches that found the shipped gaits computed them)."""
+    return q0 + gait_offsets(p, float(t), torch.float64).to(q0.device)
 
 
 SHIPPED_DIR = Path(__file__).resolve().parent / "checkpoints"
@@ -124,23 +137,6 @@ def gait_mode(row: dict) -> str:
     return f"{meta.get('skill', 'rotate')}_{meta['refine']}"
 
 
-def gait_offsets(p, t: torch.Tensor) -> torch.Tensor:
-    """:func:`gait_targets` minus q0, batched over the (fractional) control steps ``t`` [...] -> [..., 16]."""
-    period = 6 + 30 * (float(p[24]) + 1) / 2
-    t = torch.as_tensor(t, dtype=torch.float32)
-    off = torch.zeros(t.shape + (16,), device=t.device)
-    for f in range(4):
-        a_abd, a_mcp, a_dis, ph, loop, bias = (float(v) for v in p[6 * f: 6 * f + 6])
-        th = 2 * math.pi * t / period + math.pi * ph
-        j = 4 * f
-        off[..., j] = 0.3 * a_abd * torch.sin(th)
-        off[..., j + 1] = 0.5 * a_mcp * torch.sin(th) + 0.2 * bias
-        d = 0.5 * a_dis * torch.sin(th + math.pi * loop) + 0.2 * bias
-        off[..., j + 2] = d
-        off[..., j + 3] = d
-    return off
-
-
 TRACKING = ("clock", "phase")
 
 
@@ -168,7 +164,7 @@ def make_gait_policy(spec: str, tracking: str = "clock", lookahead: float = 1.0,
     if grid < 1:
         raise ValueError(f"gait grid must be >= 1, got {grid}")
     p, row = best_gait(resolve_gait(spec))
-    period = 6 + 30 * (float(p[24]) + 1) / 2
+    period = gait_period(p)
     taus = torch.arange(int(math.ceil(period * grid))) / grid
     cycle = gait_offsets(p, taus[taus < period])  # [K, 16] offsets over one period
     state = {}
