@@ -39,7 +39,7 @@ from unicross import formulation as F
 
 
 def _rollouts(gait: str, hand: str, objects: str, limit: int, trials: int, seed: int, randomize: bool,
-              student, shard, beta: float = 0.0, privileged_q0: bool = False) -> tuple:
+              student, shard, beta: float = 0.0, privileged_q0: bool = False, clock: bool = False) -> tuple:
     """One worker's share: (obs dict of [N, d], labels [N, A], trials) of the rotate protocol on its
     objects, the gait acting (``student`` None) or the student's mean acting while the gait labels;
     with ``beta`` > 0 the gait's own action is taken instead at that fraction of the steps (each env
@@ -47,11 +47,12 @@ def _rollouts(gait: str, hand: str, objects: str, limit: int, trials: int, seed:
     torch.set_num_threads(1)
     import unicross  # noqa: F401  (registers the tasks)
     from unicross import evaluation as E
-    from unicross.gaits import gait_mode, make_gait_policy
+    from unicross.gaits import best_gait, gait_mode, gait_period, make_gait_policy, resolve_gait
     from unicross.objects import get_object_set
     from unicross.rl.env import split_obs
     teacher = make_gait_policy(gait)
     axis = gait_mode(teacher.gait_row).split("_")[1]
+    period = gait_period(best_gait(resolve_gait(gait))[0])
     keys = ("hand", "object", "goal")
     rows = {k: [] for k in keys}
     labels = []
@@ -66,6 +67,9 @@ def _rollouts(gait: str, hand: str, objects: str, limit: int, trials: int, seed:
             if int(u.elapsed_steps[0]) == 0:
                 q0["q"] = u.command[:, 6:].clone()
             parts = (torch.cat([parts[0], q0["q"]], -1),) + tuple(parts[1:])
+        if clock:  # diagnosis only: the gait's clock (its phase at this step) appended to the hand state
+            th = 2 * torch.pi * u.elapsed_steps.float()[:, None] / period
+            parts = (torch.cat([parts[0], torch.sin(th), torch.cos(th)], -1),) + tuple(parts[1:])
         for k, x in zip(keys, parts):
             rows[k].append(x.clone())
         labels.append(label.clone())
@@ -101,6 +105,9 @@ def main(argv=None) -> int:
     ap.add_argument("--privileged-q0", action="store_true",
                     help="diagnosis only: the network also sees the episode's start command (the gait's centre); "
                          "its checkpoint does not fit the UniCross observation and is not written")
+    ap.add_argument("--clock", action="store_true",
+                    help="diagnosis only: the network also sees the gait's clock (sin and cos of its phase at the "
+                         "control step); its checkpoint does not fit the UniCross observation and is not written")
     ap.add_argument("--randomize", action="store_true", help="training's randomisation (default: the evaluation's conditions)")
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--seed", type=int, default=0)
@@ -137,7 +144,8 @@ def main(argv=None) -> int:
         with ProcessPoolExecutor(args.workers, mp_context=ctx) as ex:
             parts = [f.result() for f in [ex.submit(_rollouts, args.gait, args.hand, args.objects, args.limit,
                                                      args.trials, args.seed + 7919 * r, args.randomize, student,
-                                                     (i, args.workers), beta_of(r), args.privileged_q0)
+                                                     (i, args.workers), beta_of(r), args.privileged_q0,
+                                                     args.clock)
                                            for i in range(args.workers)]]
         o = {k: torch.cat([p[0][k] for p in parts]) for k in parts[0][0]}
         y = torch.cat([p[1] for p in parts])
@@ -150,7 +158,12 @@ def main(argv=None) -> int:
         if actor is not None:  # the network's error on states it was not fitted to (before it sees them)
             with torch.no_grad():
                 loc, _ = actor(o["hand"], o["object"], o["goal"])
-                row["fresh_mse"] = float(torch.nn.functional.mse_loss(loc.clamp(-1, 1), y))
+                err = (loc.clamp(-1, 1) - y).pow(2).mean(-1)
+                stopped = (y == 0).all(-1)  # the gait's stop: the object has turned far enough
+                row["fresh_mse"] = float(err.mean())
+                row["fresh_mse_moving"] = float(err[~stopped].mean()) if (~stopped).any() else float("nan")
+                row["fresh_mse_stopped"] = float(err[stopped].mean()) if stopped.any() else float("nan")
+                row["stopped_share"] = float(stopped.float().mean())
         if r > 0 and beta_of(r) == 0:  # only rollouts of the network alone select it
             fitted[r]["success"] = sr
         if r == args.rounds:  # the last round only measures the final network
@@ -197,13 +210,14 @@ def main(argv=None) -> int:
               skill=skill, axis=axis, hand=args.hand, env_id=R.skill(skill).env_id,
               env_kwargs=env_kwargs_for(skill, axis, args.hand, cfg["env"]), iteration=0, frames=0,
               git_commit=git_commit(), commits=[git_commit()])
-    if not args.privileged_q0:
+    diagnosis = args.privileged_q0 or args.clock
+    if not diagnosis:
         torch.save(ck, out / "policy.pt")
     with open(out / "log.jsonl", "w") as f:
         f.writelines(json.dumps(x) + "\n" for x in log)
     (out / "command.txt").write_text("python benchmarks/gait_clone.py " + " ".join(sys.argv[1:] if argv is None else argv)
                                      + f"  # commit {git_commit()}\n")
-    what = "(not written: --privileged-q0)" if args.privileged_q0 else f"wrote {out / 'policy.pt'}:"
+    what = "(not written: a diagnosis run)" if diagnosis else f"wrote {out / 'policy.pt'}:"
     print(f"{what} the network of round {best} ({100 * fitted[best]['success']:.1f}% "
           f"of its episodes; {time.time() - t0:.0f} s)")
     return 0

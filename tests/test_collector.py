@@ -218,3 +218,56 @@ def test_teacher_settings_are_refused_before_simulating(tmp_path):
     with pytest.raises(ValueError, match="needs collector.teacher"):
         PPOTrainer(tmp_path / "r", skill="rotate", axis="y-", overrides={"loss": {"teacher_coef": 1.0}})
     assert not (tmp_path / "r" / "checkpoint.pt").exists()
+    base = {"model": {"base_policy": "allegro/rotate_y-"}}
+    with pytest.raises(ValueError, match="model.base_policy=allegro/rotate_y- is a gait for rotate_y-"):
+        PPOTrainer(tmp_path / "r", skill="rotate", axis="z+", overrides=base)
+    with pytest.raises(ValueError, match="leave loss.teacher_coef at 0"):
+        PPOTrainer(tmp_path / "r", skill="rotate", axis="y-", overrides=dict(base, loss={"teacher_coef": 1.0}))
+    with pytest.raises(ValueError, match="differ"):
+        PPOTrainer(tmp_path / "r", skill="rotate", axis="y-",
+                   overrides=dict(base, collector={"teacher": "allegro/rotate_y-,tracking=phase"}))
+    with pytest.raises(ValueError, match="acts on top of base policy None"):  # a plain network cannot start a residual run
+        PPOTrainer(tmp_path / "r", skill="rotate", axis="y-",
+                   overrides={"model": {"base_policy": "allegro/rotate_y-", "init_policy": "allegro/rotate_y-"}})
+    assert not (tmp_path / "r" / "checkpoint.pt").exists()
+
+
+class _ConstActor(torch.nn.Module):
+    """A mean of 0.3 on the first finger joints and -0.4 on the last, whatever the state."""
+    def forward(self, hand, obj, goal):
+        loc = torch.zeros(hand.shape[0], 22)
+        loc[:, 6:10], loc[:, -4:] = 0.3, -0.4
+        return loc, torch.full_like(loc, 0.1)
+
+
+def test_a_residual_rollout_steps_the_env_with_the_gait_plus_the_network():
+    """``model.base_policy``: the env takes clip(gait + network action); the batch stores the
+    network's action (PPO's ratio is the network's) and the gait's in ``teacher_action``. A twin env
+    stepped by hand with clip(gait + action) sees the same observations."""
+    import gymnasium as gym
+    from unicross.config import load_config
+    from unicross.rl.ppo import env_kwargs_for
+    kw = dict(env_kwargs_for("rotate", "y-", "allegro", load_config("ppo")["env"]), object_limit=1)
+    c = LeanCollector(R_ID, kw, num_envs=1, horizon=6, seed=5, deterministic=True, teacher="allegro/rotate_y-",
+                      residual=True)
+    try:
+        c.set_actor(_ConstActor())
+        data = c.collect()
+    finally:
+        c.close()
+    twin = gym.make(R_ID, render_backend="none", obs_mode="state_dict", num_envs=1, sim_backend="physx_cpu", **kw)
+    try:
+        u = twin.unwrapped
+        u.reset(seed=5)
+        gait = C.make_teacher("allegro/rotate_y-")
+        for t in range(6):
+            label = gait(u)
+            torch.testing.assert_close(data["teacher_action"][:, t], label)
+            obs, *_ = u.step(C.residual_action(label, data["action"][:, t]))
+            torch.testing.assert_close(data["next", "hand"][:, t], obs["extra"]["hand"])
+    finally:
+        twin.close()
+    torch.testing.assert_close(data["action"][:, :, 6:10], torch.full((1, 6, 4), 0.3))
+    assert (data["teacher_action"][:, :, 6:] + data["action"][:, :, 6:]).abs().max() > 1.0  # the clip is exercised
+    with pytest.raises(ValueError, match="base gait"):
+        C.Rollout(R_ID, dict(kw, num_envs=1, sim_backend="physx_cpu"), seed=0, residual=True)

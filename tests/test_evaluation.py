@@ -155,3 +155,41 @@ def test_eval_ablation_flags_checked_before_simulation(tmp_path, capsys):
     assert main(["eval", "--policy", "allegro/relocate", "--protocol", "relocate", "--ablation", "no_target_action",
                  "--out", out]) == 2
     assert "trained with ablation none" in capsys.readouterr().err
+
+
+def test_a_residual_checkpoint_acts_on_top_of_its_gait_and_is_refused_as_a_dagger_teacher(tmp_path):
+    """A checkpoint trained with ``model.base_policy`` acts as clip(gait + network mean) wherever
+    it is evaluated; DAgger refuses it as a teacher (it distils networks alone)."""
+    import gymnasium as gym
+    from unicross.gaits import make_gait_policy
+    from unicross.rl.dagger import Teachers
+    from unicross.rl.env import split_obs
+    from unicross.rl.policy_io import load_policy, read_torch_file, resolve_checkpoint
+    ck = read_torch_file(resolve_checkpoint("allegro/rotate_y-"), "checkpoint")
+    ck["config"] = dict(ck["config"], model=dict(ck["config"]["model"], base_policy="allegro/rotate_y-"))
+    path = tmp_path / "residual.pt"
+    torch.save(ck, path)
+    fn, desc = E.resolve_policy(str(path), "allegro")
+    assert desc["base_policy"] == "allegro/rotate_y-"
+    plain, _ = E.resolve_policy("allegro/rotate_y-", "allegro")
+    net, _ = load_policy(path)
+    env = gym.make("UniCross-Rotate-v1", axis="y-", obs_mode="state_dict", sim_backend="physx_cpu",
+                   render_backend="none", objects=get_object_set("train-wrappable", limit=1), randomize=False)
+    try:
+        u = env.unwrapped
+        obs, _ = u.reset(seed=3)
+        gait = make_gait_policy("allegro/rotate_y-")
+        for _ in range(4):
+            with torch.no_grad():
+                loc, _ = net.module[0].module(*split_obs(obs))
+            want = (gait(obs, u) + loc).clamp(-1, 1)
+            got = fn(obs, u)
+            torch.testing.assert_close(got, want)
+            assert (got - plain(obs, u)).abs().max() > 0.01  # not the network alone
+            obs, *_ = u.step(got)
+    finally:
+        env.close()
+    (tmp_path / "rotate_y-").mkdir()
+    torch.save(ck, tmp_path / "rotate_y-" / "checkpoint.pt")
+    with pytest.raises(ValueError, match="networks alone"):
+        Teachers({"rotate_y-": tmp_path / "rotate_y-" / "checkpoint.pt"}, "cpu")

@@ -162,7 +162,7 @@ def resolve_policy(spec: str, hand: str, seed: int = 0):
         from unicross.gaits import gait_mode
         return policy, dict(kind="gait", path=path, mode=gait_mode(policy.gait_row), gait=policy.gait_row["p"],
                             meta=policy.gait_row.get("meta", {}))
-    from unicross.rl.policy_io import act, load_policy
+    from unicross.rl.policy_io import base_policy_of, load_policy, policy_fn
     from unicross.robots.hand import load_hand
     policy, ck = load_policy(spec)
     spec_h = load_hand(hand)
@@ -174,9 +174,12 @@ def resolve_policy(spec: str, hand: str, seed: int = 0):
         raise ValueError(f"checkpoint {spec} expects observation {ck['obs_dims']} / action {ck['n_act']}, "
                          f"hand {hand!r} gives {expected} / {spec_h.dof}")
     task_config = (ck.get("env_kwargs") or {}).get("config") or {}
-    return (lambda obs, u: act(policy, obs)), dict(kind="checkpoint", path=str(spec), skill=ck.get("skill"),
-                                                   axis=ck.get("axis"), git_commit=ck.get("git_commit"),
-                                                   ablation=task_config.get("ablation", {}))
+    base = base_policy_of(ck)  # a residual policy acts on top of its gait (refused for another hand above)
+    desc = dict(kind="checkpoint", path=str(spec), skill=ck.get("skill"), axis=ck.get("axis"),
+                git_commit=ck.get("git_commit"), ablation=task_config.get("ablation", {}))
+    if base is not None:
+        desc["base_policy"] = base
+    return policy_fn(policy.module[0].module, base), desc
 
 
 # ----------------------------------------------------------------------------- one protocol

@@ -68,23 +68,29 @@ def make_teacher(spec: Optional[str]):
     return lambda task: gait(None, task)
 
 
+def residual_action(base: torch.Tensor, action: torch.Tensor) -> torch.Tensor:
+    """The env's action under ``model.base_policy``: the base gait's action plus the network's,
+    clipped to the action box (the env would clip it too)."""
+    return (base + action).clamp(-1.0, 1.0)
+
+
 def check_teacher(spec: Optional[str], skill: str, axis: Optional[str], backend: str,
-                  ray_address: Optional[str] = None) -> None:
+                  ray_address: Optional[str] = None, what: str = "collector.teacher") -> None:
     """Refuses (before any simulation) a ``collector.teacher`` that is not a gait of this run's mode,
     or one on the GPU backend (its sub-scenes reset one by one; a gait keeps one clock) or with Ray
     env actors (which do not carry it)."""
     if spec is None:
         return
     if ray_address:
-        raise ValueError("collector.teacher is not supported with collector.ray_address (Ray env actors)")
+        raise ValueError(f"{what} is not supported with collector.ray_address (Ray env actors)")
     if backend != "physx_cpu":
-        raise ValueError("collector.teacher (a scripted gait) needs env.backend physx_cpu: a gait keeps one clock "
+        raise ValueError(f"{what} (a scripted gait) needs env.backend physx_cpu: a gait keeps one clock "
                          "for all its envs, and GPU sub-scenes reset one by one")
     from unicross.gaits import gait_mode, make_gait_policy
     mode = gait_mode(make_gait_policy(spec).gait_row)  # also checks the gait's options
     ours = f"{skill}_{axis}" if axis else skill
     if mode != ours:
-        raise ValueError(f"collector.teacher={spec} is a gait for {mode}, this run trains {ours}")
+        raise ValueError(f"{what}={spec} is a gait for {mode}, this run trains {ours}")
 
 
 class Rollout:
@@ -101,10 +107,13 @@ class Rollout:
     the actions, so correlated noise moves them ~sqrt((1 + ρ)/(1 - ρ)) times farther per episode
     (4.4x at 0.9) at the same per-step spread.
 
-    ``teacher`` (:func:`make_teacher`): its action in every state is written to ``teacher_action``."""
+    ``teacher`` (:func:`make_teacher`): its action in every state is written to ``teacher_action``;
+    with ``residual`` the env also takes it added to the policy's action (``model.base_policy``:
+    :func:`residual_action`; the stored action, its log-probability and PPO's ratio are the
+    network's, the gait being part of the env as PPO sees it)."""
 
     def __init__(self, env_id: str, env_kwargs: dict, seed: int, deterministic: bool = False,
-                 noise_correlation: float = 0.0, teacher: Optional[str] = None):
+                 noise_correlation: float = 0.0, teacher: Optional[str] = None, residual: bool = False):
         import gymnasium as gym
         import unicross  # noqa: F401  (registers the tasks)
         kw = dict(render_backend="none", **env_kwargs)
@@ -119,6 +128,9 @@ class Rollout:
         self.rho = float(noise_correlation)
         self.eps: Optional[torch.Tensor] = None  # the AR(1) noise state (rho > 0)
         self.teacher = make_teacher(teacher)
+        if residual and self.teacher is None:
+            raise ValueError("a residual rollout needs its base gait (teacher)")
+        self.residual = residual
         obs, _ = self.task.reset(seed=seed)
         self.obs = split_obs(obs)
         self.dims = {k: x.shape[-1] for k, x in zip(OBS_KEYS, self.obs)}
@@ -142,14 +154,15 @@ class Rollout:
         for t in range(buf.shape[1]):
             for dst, x in zip(obs_buf, self.obs):
                 dst[:, t] = x
+            base = None
             if teacher_b is not None:
-                teacher_b[:, t] = self.teacher(self.task)
+                teacher_b[:, t] = base = self.teacher(self.task)
             loc, scale = self.actor(*self.obs)
             noise = torch.zeros_like(loc) if self.deterministic else self._noise(loc.shape)
             a = loc + scale * noise
             act[:, t], loc_b[:, t], scale_b[:, t] = a, loc, scale
             logp[:, t] = (-0.5 * noise ** 2 - scale.log() - half_log_2pi).sum(-1)
-            obs, reward, terminated, truncated, info = self.task.step(a)
+            obs, reward, terminated, truncated, info = self.task.step(residual_action(base, a) if self.residual else a)
             nxt = split_obs(obs)
             for dst, x in zip(nxt_obs, nxt):
                 dst[:, t] = x
@@ -182,13 +195,13 @@ class Rollout:
 
 
 def _worker(rank: int, env_id: str, env_kwargs: dict, seed: int, deterministic: bool, noise_correlation: float,
-            teacher: Optional[str], conn) -> None:
+            teacher: Optional[str], residual: bool, conn) -> None:
     """Worker process: one env. Reports its sizes, receives the shared actor and buffer, then
     fills row ``rank`` of the buffer on every "collect"."""
     torch.set_num_threads(1)
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C reaches the whole group; the main process stops us
     try:
-        rollout = Rollout(env_id, env_kwargs, seed, deterministic, noise_correlation, teacher)
+        rollout = Rollout(env_id, env_kwargs, seed, deterministic, noise_correlation, teacher, residual)
         conn.send(("ready", (rollout.dims, rollout.n_act)))
         msg, (actor, buf) = conn.recv()
         rollout.set_actor(actor)
@@ -280,14 +293,15 @@ class LeanCollector:
     its action noise from a generator seeded likewise (``deterministic``: the mean action, as
     DAgger's student acts; the stored log-probability is then that of the mean), AR(1) in time with
     ``noise_correlation`` (see :class:`Rollout`); ``teacher``: a gait labelling every state
-    (:func:`make_teacher`). The envs are built first (``dims``,
+    (:func:`make_teacher`), which the envs also take added to the policy's action with ``residual``
+    (``model.base_policy``). The envs are built first (``dims``,
     ``n_act`` come from them); :meth:`set_actor` then hands them the actor, whose tensors are moved
     to shared memory, so the optimiser's in-place steps and the statistics updates reach the workers.
     """
 
     def __init__(self, env_id: str, env_kwargs: dict, num_envs: int, horizon: int, seed: int = 0,
                  backend: str = "physx_cpu", deterministic: bool = False, noise_correlation: float = 0.0,
-                 teacher: Optional[str] = None):
+                 teacher: Optional[str] = None, residual: bool = False):
         self.horizon, self.num_envs, self.teacher = horizon, num_envs, teacher is not None
         kw = dict(env_kwargs)
         self._procs, self._conns, self._local, self.buf = [], [], None, None
@@ -296,14 +310,14 @@ class LeanCollector:
         else:
             kw.update(sim_backend="physx_cpu", num_envs=1)
         if backend == "physx_cuda" or num_envs == 1:
-            self._local = Rollout(env_id, kw, seed, deterministic, noise_correlation, teacher)
+            self._local = Rollout(env_id, kw, seed, deterministic, noise_correlation, teacher, residual)
             self.dims, self.n_act, self.device = self._local.dims, self._local.n_act, self._local.device
             return
         ctx = mp.get_context("spawn")
         for rank in range(num_envs):
             parent, child = ctx.Pipe()
             p = ctx.Process(target=_worker, args=(rank, env_id, kw, seed + rank, deterministic, noise_correlation, teacher,
-                                                          child), daemon=True,
+                                                          residual, child), daemon=True,
                             name=f"unicross-env-{rank}")
             p.start()
             self._procs.append(p)
@@ -408,7 +422,7 @@ def resolve_num_envs(num_envs, backend: str, ray_address: Optional[str] = None) 
 
 def make_collector(env_id: str, env_kwargs: dict, num_envs: int, horizon: int, seed: int, backend: str,
                    ray_address: Optional[str] = None, deterministic: bool = False, noise_correlation: float = 0.0,
-                   teacher: Optional[str] = None):
+                   teacher: Optional[str] = None, residual: bool = False):
     """The collector of a trainer: Ray env actors when ``ray_address`` is set (see
     :func:`resolve_num_envs`, which connects), else :class:`LeanCollector`."""
     if not 0.0 <= noise_correlation < 1.0:
@@ -418,4 +432,5 @@ def make_collector(env_id: str, env_kwargs: dict, num_envs: int, horizon: int, s
         return RayCollector(env_id, env_kwargs, num_envs, horizon, seed=seed, address=ray_address,
                             deterministic=deterministic, noise_correlation=noise_correlation)
     return LeanCollector(env_id, env_kwargs, num_envs, horizon, seed=seed, backend=backend,
-                         deterministic=deterministic, noise_correlation=noise_correlation, teacher=teacher)
+                         deterministic=deterministic, noise_correlation=noise_correlation, teacher=teacher,
+                         residual=residual)

@@ -30,7 +30,7 @@ from unicross import formulation as F
 from unicross import registry as R
 from unicross.rl.collector import make_collector, resolve_num_envs
 from unicross.rl.models import OBS_KEYS, make_models
-from unicross.rl.policy_io import load_policy
+from unicross.rl.policy_io import base_policy_of, load_policy
 from unicross.rl.runner import CKPT_NAME, Runner, atomic_save
 
 
@@ -54,6 +54,9 @@ class Teachers(torch.nn.Module):
         self.hand = None
         for m, p in paths.items():
             pol, ck = load_policy(p, device)
+            if base_policy_of(ck) is not None:
+                raise ValueError(f"expert {p} acts on top of the gait {base_policy_of(ck)} (model.base_policy): "
+                                 "DAgger distils experts that are networks alone")
             trained = R.skill(ck["skill"]).mode(ck.get("axis")) if ck.get("skill") in R.SKILLS else ck.get("skill")
             if trained != m:
                 raise ValueError(f"expert {p} was trained for mode {trained!r}, not {m!r}: each mode's folder "

@@ -94,9 +94,26 @@ def act(policy, obs: dict, deterministic: bool = True) -> torch.Tensor:
 
 
 @torch.no_grad()
-def actor_action(actor, obs: dict, deterministic: bool = True) -> torch.Tensor:
-    """:func:`act` for the bare network ``(hand, object, goal) -> (loc, scale)``."""
+def actor_action(actor, obs: dict, deterministic: bool = True, base=None) -> torch.Tensor:
+    """:func:`act` for the bare network ``(hand, object, goal) -> (loc, scale)``; with ``base`` (the
+    action of the policy's base gait, ``model.base_policy``) the network's action is added to it
+    before the clip, as in training (:func:`unicross.rl.collector.residual_action`)."""
     loc, scale = actor(*split_obs(obs))
     if not deterministic:
         loc = loc + scale * torch.randn_like(loc)
-    return loc.clamp(-1.0, 1.0)
+    return loc.clamp(-1.0, 1.0) if base is None else (base + loc).clamp(-1.0, 1.0)
+
+
+def base_policy_of(ck: dict):
+    """The scripted gait a checkpoint's network acts on top of (``model.base_policy``), or None."""
+    return ((ck.get("config") or {}).get("model") or {}).get("base_policy")
+
+
+def policy_fn(actor, base_policy=None):
+    """``(obs, task) -> action`` of the bare network (its mean), on top of its base gait when it has
+    one (:func:`base_policy_of`): the way a checkpoint acts wherever it is evaluated."""
+    if base_policy is None:
+        return lambda obs, u: actor_action(actor, obs)
+    from unicross.gaits import make_gait_policy
+    gait = make_gait_policy(base_policy)
+    return lambda obs, u: actor_action(actor, obs, base=gait(obs, u))

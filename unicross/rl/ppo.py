@@ -66,10 +66,11 @@ def env_kwargs_for(skill: str, axis: Optional[str], hand: str, env_cfg: dict) ->
     return kw
 
 
-def policy_to_start_from(path, skill: str, axis: Optional[str], hand: str) -> dict:
+def policy_to_start_from(path, skill: str, axis: Optional[str], hand: str, base_policy: Optional[str] = None) -> dict:
     """The policy checkpoint that ``model.init_policy`` names (e.g. a gait cloned by
-    ``benchmarks/gait_clone.py``), refused unless it acts for this run's skill, axis and hand."""
-    from unicross.rl.policy_io import read_torch_file, resolve_checkpoint, check_modes
+    ``benchmarks/gait_clone.py``), refused unless it acts for this run's skill, axis and hand, on top
+    of the same base gait (``model.base_policy``) or of none, as this run."""
+    from unicross.rl.policy_io import base_policy_of, read_torch_file, resolve_checkpoint, check_modes
     path = resolve_checkpoint(path)
     ck = read_torch_file(path, "checkpoint")
     if not isinstance(ck, dict) or "policy" not in ck or "obs_dims" not in ck:
@@ -78,16 +79,19 @@ def policy_to_start_from(path, skill: str, axis: Optional[str], hand: str) -> di
     theirs, ours = (ck.get("skill"), ck.get("axis"), ck.get("hand")), (skill, axis, hand)
     if theirs != ours:
         raise ValueError(f"model.init_policy={path} acts for skill/axis/hand {theirs}, this run trains {ours}")
+    if base_policy_of(ck) != base_policy:
+        raise ValueError(f"model.init_policy={path} acts on top of base policy {base_policy_of(ck)}, this run on "
+                         f"{base_policy} (model.base_policy)")
     return ck
 
 
 def evaluation_shard(actor, skill: str, objects: str, limit, trials_per_object: int, seed: int, hand: str,
-                     axis: Optional[str], ablation: Optional[dict], shard) -> list:
+                     axis: Optional[str], ablation: Optional[dict], shard, base_policy: Optional[str] = None) -> list:
     """One worker's share of a held-out evaluation (see :meth:`PPOTrainer._protocol`)."""
     from unicross import evaluation as E
     from unicross.objects import get_object_set
-    from unicross.rl.policy_io import actor_action
-    return E.run_protocol(skill, lambda obs, u: actor_action(actor, obs), get_object_set(objects, limit=limit),
+    from unicross.rl.policy_io import policy_fn
+    return E.run_protocol(skill, policy_fn(actor, base_policy), get_object_set(objects, limit=limit),
                           hand=hand, trials_per_object=trials_per_object, seed=seed, progress=False,
                           axes=[axis] if axis else None, ablation=ablation, shard=shard)
 
@@ -122,7 +126,8 @@ class PPOTrainer(Runner):
         spec = load_hand(hand)  # validates
         start_mean, start_policy = None, None
         if self.ckpt is None and cfg["model"].get("init_policy"):  # refused before any simulation
-            start_policy = policy_to_start_from(cfg["model"]["init_policy"], skill, axis, hand)
+            start_policy = policy_to_start_from(cfg["model"]["init_policy"], skill, axis, hand,
+                                                cfg["model"].get("base_policy"))
         if self.ckpt is None and cfg["model"].get("init_reference") is not None:
             from unicross.audit import reference_action
             start_mean = reference_action(skill, axis, spec, float(cfg["model"]["init_reference"]))
@@ -130,8 +135,16 @@ class PPOTrainer(Runner):
         self.env_id = R.skill(skill).env_id
         self.env_kwargs = env_kwargs_for(skill, axis, hand, cfg["env"])
         ec = cfg["env"]
-        teacher = cfg["collector"].get("teacher")
+        teacher, base = cfg["collector"].get("teacher"), cfg["model"].get("base_policy")
+        if base is not None and teacher is not None and teacher != base:
+            raise ValueError(f"collector.teacher={teacher} and model.base_policy={base} differ: the base gait "
+                             "labels the collected states itself (leave collector.teacher null or set it the same)")
+        check_teacher(base, skill, axis, ec["backend"], cfg["collector"].get("ray_address"), what="model.base_policy")
+        teacher = teacher or base
         check_teacher(teacher, skill, axis, ec["backend"], cfg["collector"].get("ray_address"))
+        if float(cfg["loss"].get("teacher_coef", 0.0)) > 0.0 and base is not None:
+            raise ValueError("loss.teacher_coef pulls the network's action toward the gait's, but with model.base_policy "
+                             "the network's action is added to the gait's: leave loss.teacher_coef at 0")
         if float(cfg["loss"].get("teacher_coef", 0.0)) > 0.0 and teacher is None:
             raise ValueError("loss.teacher_coef > 0 needs collector.teacher (e.g. allegro/rotate_y-)")
         self.share_cores(ec["backend"])
@@ -142,7 +155,7 @@ class PPOTrainer(Runner):
         self.collector = make_collector(self.env_id, self.env_kwargs, num_envs, self.horizon, seed, ec["backend"],
                                         cfg["collector"].get("ray_address"),
                                         noise_correlation=float(cfg["collector"].get("noise_correlation", 0.0)),
-                                        teacher=teacher)
+                                        teacher=teacher, residual=base is not None)
         self.device = self.collector.device
         dims, self.n_act = self.collector.dims, self.collector.n_act
         self.algo = PPO(dims, self.n_act, cfg, self.collector.frames_per_batch, self.device)
@@ -199,7 +212,8 @@ class PPOTrainer(Runner):
         objs = get_object_set(objects, limit=limit)
         shards = self.collector.map_shards(
             evaluation_shard, skill=self.skill, objects=objects, limit=limit, trials_per_object=trials_per_object,
-            seed=seed, hand=self.hand, axis=self.axis, ablation=(self.cfg["env"].get("task_config") or {}).get("ablation"))
+            seed=seed, hand=self.hand, axis=self.axis, ablation=(self.cfg["env"].get("task_config") or {}).get("ablation"),
+            base_policy=self.cfg["model"].get("base_policy"))
         trials = E.merge_shards(self.skill, objs, shards)
         return trials, E.summarize(self.skill, trials)
 
