@@ -72,3 +72,14 @@ def test_paper_values_format():
     from unicross.report import _paper
     assert _paper("Ours", "relocate") == "99.0 / 0.54 / 0.0134"
     assert _paper("Experts", "grasp") == "99.0"
+
+
+def test_a_checkpoint_on_top_of_a_gait_is_named_so_in_the_tables(tmp_path):
+    import torch
+    from unicross.report import policy_label
+    from unicross.rl.policy_io import read_torch_file, resolve_checkpoint
+    assert policy_label("allegro/rotate_y-") == "allegro/rotate_y-"
+    ck = read_torch_file(resolve_checkpoint("allegro/rotate_y-"), "checkpoint")
+    ck["config"] = dict(ck["config"], model=dict(ck["config"]["model"], base_policy="allegro/rotate_y-"))
+    torch.save(ck, tmp_path / "r.pt")
+    assert policy_label(str(tmp_path / "r.pt")) == f"{tmp_path / 'r.pt'} (PPO on top of gait:allegro/rotate_y-)"

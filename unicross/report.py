@@ -39,6 +39,14 @@ def shipped(hand: str = "allegro") -> Dict[str, str]:
     return {n: f"{hand}/{n}" for n in names if (d / f"{n}.pt").exists()}
 
 
+def policy_label(spec: str) -> str:
+    """A checkpoint's name in the tables, saying so when it acts on top of a scripted gait
+    (``model.base_policy``)."""
+    from unicross.rl.policy_io import base_policy_of, read_torch_file, resolve_checkpoint
+    base = base_policy_of(read_torch_file(resolve_checkpoint(spec), "checkpoint"))
+    return spec if base is None else f"{spec} (PPO on top of gait:{base})"
+
+
 def _paper(setting: str, skill: str) -> str:
     v = PAPER[setting].get(skill)
     return "--" if v is None else " / ".join([f"{v[0]:.1f}"] + [f"{x:g}" for x in v[1:]])
@@ -114,7 +122,7 @@ class PaperReport:
                 why = "" if mode in self.ckpts else ": no expert"
                 rows.append((mode, f"{spec} (not distilled for this mode{why})", "--"))
             else:
-                rows.append((mode, spec, self.evaluate(mode, spec, objects, disturb)))
+                rows.append((mode, policy_label(spec), self.evaluate(mode, spec, objects, disturb)))
         return rows
 
     def markdown(self, command: str) -> str:
