@@ -209,3 +209,12 @@ def test_an_evaluations_markdown_sits_beside_its_json_under_its_own_name():
     assert markdown_path(Path("d/e.json")) == Path("d/e.md")
     assert markdown_path(Path("d/heldout")) == Path("d/heldout.md")
     assert markdown_path(Path("d/lookahead1.5")) == Path("d/lookahead1.5.md")  # was d/lookahead1.md
+
+
+def test_the_wrist_can_start_with_its_own_exploration_noise():
+    from unicross.rl.models import make_models
+    dims = dict(hand=44, object=105, goal=37)
+    head = make_models(dims, 22, None, dict(init_log_std=-4.0, init_log_std_wrist=-1.0))[0].module[0].module
+    assert head.log_std[:6].tolist() == [-1.0] * 6 and head.log_std[6:].tolist() == [-4.0] * 16
+    head = make_models(dims, 22, None, dict(init_log_std=-2.0))[0].module[0].module
+    assert head.log_std.tolist() == [-2.0] * 22

@@ -20,6 +20,8 @@ from tensordict.nn import TensorDictModule, TensorDictSequential
 from torch import nn
 from torchrl.modules import IndependentNormal, ProbabilisticActor, ValueOperator
 
+from unicross.robots.hand import WRIST_JOINTS
+
 OBS_KEYS = ("hand", "object", "goal")
 
 
@@ -121,10 +123,18 @@ class ValueNormalizer(nn.Module):
 
 
 class GaussianHead(nn.Module):
-    def __init__(self, net: UniCrossNet, n_act: int, init_log_std: float = -0.5, init_scale: float = 1.0):
+    """A diagonal Gaussian over the action: the network's mean and a state-independent log std,
+    ``init_log_std`` at the start (``init_log_std_wrist`` for the six virtual wrist dims, which come
+    first in every hand's action, when given)."""
+
+    def __init__(self, net: UniCrossNet, n_act: int, init_log_std: float = -0.5, init_scale: float = 1.0,
+                 init_log_std_wrist: float | None = None):
         super().__init__()
         self.net = net
         self.log_std = nn.Parameter(torch.full((n_act,), init_log_std))
+        if init_log_std_wrist is not None:
+            with torch.no_grad():
+                self.log_std[:len(WRIST_JOINTS)] = init_log_std_wrist
         last = net.main[-1]
         with torch.no_grad():  # near-zero initial action mean
             last.weight.mul_(init_scale)
@@ -151,7 +161,7 @@ def make_models(dims: dict, n_act: int, action_spec=None, cfg: dict | None = Non
     enc, main = tuple(cfg.get("encoder_hidden", (128, 64))), tuple(cfg.get("main_hidden", (512, 256, 128)))
     norm = ObsNormalizer(dims)
     actor = GaussianHead(UniCrossNet(dims, n_act, norm, enc, main), n_act, cfg.get("init_log_std", -0.5),
-                         cfg.get("action_init_scale", 1.0))
+                         cfg.get("action_init_scale", 1.0), cfg.get("init_log_std_wrist"))
     policy = ProbabilisticActor(
         TensorDictModule(actor, in_keys=list(OBS_KEYS), out_keys=["loc", "scale"]),
         in_keys=["loc", "scale"], distribution_class=IndependentNormal, return_log_prob=True, spec=action_spec)
