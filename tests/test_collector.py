@@ -179,30 +179,43 @@ class _ZeroActor(torch.nn.Module):
         return loc, torch.full_like(loc, 0.1)
 
 
-def test_a_gait_teacher_labels_every_collected_state():
-    """``collector.teacher``: the batch's ``teacher_action`` is what the gait, run alongside on an
-    identical env that takes the same actions, gives in each collected state."""
+def _gait_rollout_and_twin(actor, residual: bool, horizon: int = 6, seed: int = 5):
+    """A 6-step rollout of the y- gait teacher (``residual``: the env takes gait + actor), the env
+    kwargs, and a generator over a twin env reset alike: ``(t, twin env, the gait's label in its state)`` per step;
+    the caller steps the twin. The twin is closed when the generator is exhausted."""
     import gymnasium as gym
     from unicross.config import load_config
     from unicross.rl.ppo import env_kwargs_for
     kw = dict(env_kwargs_for("rotate", "y-", "allegro", load_config("ppo")["env"]), object_limit=1)
-    c = LeanCollector(R_ID, kw, num_envs=1, horizon=6, seed=5, deterministic=True, teacher="allegro/rotate_y-")
+    c = LeanCollector(R_ID, kw, num_envs=1, horizon=horizon, seed=seed, deterministic=True,
+                      teacher="allegro/rotate_y-", residual=residual)
     try:
-        c.set_actor(_ZeroActor())
+        c.set_actor(actor)
         data = c.collect()
     finally:
         c.close()
-    twin = gym.make(R_ID, render_backend="none", obs_mode="state_dict", num_envs=1, sim_backend="physx_cpu", **kw)
-    try:
-        u = twin.unwrapped
-        u.reset(seed=5)
-        gait = C.make_teacher("allegro/rotate_y-")
-        for t in range(6):
-            label = gait(u)
-            torch.testing.assert_close(data["teacher_action"][:, t], label)
-            u.step(data["action"][:, t])
-    finally:
-        twin.close()
+
+    def twin():
+        env = gym.make(R_ID, render_backend="none", obs_mode="state_dict", num_envs=1, sim_backend="physx_cpu", **kw)
+        try:
+            u = env.unwrapped
+            u.reset(seed=seed)
+            gait = C.make_teacher("allegro/rotate_y-")
+            for t in range(horizon):
+                yield t, u, gait(u)
+        finally:
+            env.close()
+
+    return data, kw, twin()
+
+
+def test_a_gait_teacher_labels_every_collected_state():
+    """``collector.teacher``: the batch's ``teacher_action`` is what the gait, run alongside on an
+    identical env that takes the same actions, gives in each collected state."""
+    data, _, twin = _gait_rollout_and_twin(_ZeroActor(), residual=False)
+    for t, u, label in twin:
+        torch.testing.assert_close(data["teacher_action"][:, t], label)
+        u.step(data["action"][:, t])
     assert data["teacher_action"][:, :, 6:].abs().max() > 0.05  # the gait moves the fingers
     assert torch.equal(data["action"], torch.zeros_like(data["action"]))
 
@@ -244,29 +257,11 @@ def test_a_residual_rollout_steps_the_env_with_the_gait_plus_the_network():
     """``model.base_policy``: the env takes clip(gait + network action); the batch stores the
     network's action (PPO's ratio is the network's) and the gait's in ``teacher_action``. A twin env
     stepped by hand with clip(gait + action) sees the same observations."""
-    import gymnasium as gym
-    from unicross.config import load_config
-    from unicross.rl.ppo import env_kwargs_for
-    kw = dict(env_kwargs_for("rotate", "y-", "allegro", load_config("ppo")["env"]), object_limit=1)
-    c = LeanCollector(R_ID, kw, num_envs=1, horizon=6, seed=5, deterministic=True, teacher="allegro/rotate_y-",
-                      residual=True)
-    try:
-        c.set_actor(_ConstActor())
-        data = c.collect()
-    finally:
-        c.close()
-    twin = gym.make(R_ID, render_backend="none", obs_mode="state_dict", num_envs=1, sim_backend="physx_cpu", **kw)
-    try:
-        u = twin.unwrapped
-        u.reset(seed=5)
-        gait = C.make_teacher("allegro/rotate_y-")
-        for t in range(6):
-            label = gait(u)
-            torch.testing.assert_close(data["teacher_action"][:, t], label)
-            obs, *_ = u.step(C.residual_action(label, data["action"][:, t]))
-            torch.testing.assert_close(data["next", "hand"][:, t], obs["extra"]["hand"])
-    finally:
-        twin.close()
+    data, kw, twin = _gait_rollout_and_twin(_ConstActor(), residual=True)
+    for t, u, label in twin:
+        torch.testing.assert_close(data["teacher_action"][:, t], label)
+        obs, *_ = u.step(C.residual_action(label, data["action"][:, t]))
+        torch.testing.assert_close(data["next", "hand"][:, t], obs["extra"]["hand"])
     torch.testing.assert_close(data["action"][:, :, 6:10], torch.full((1, 6, 4), 0.3))
     assert (data["teacher_action"][:, :, 6:] + data["action"][:, :, 6:]).abs().max() > 1.0  # the clip is exercised
     with pytest.raises(ValueError, match="base gait"):
