@@ -37,6 +37,7 @@ import torch.multiprocessing as mp
 from tensordict import TensorDict
 
 from unicross.rl.env import INFO_BOOL, info_float_keys, split_obs
+from unicross.rl.policy_io import residual_action
 
 OBS_KEYS = ("hand", "object", "goal")
 
@@ -66,12 +67,6 @@ def make_teacher(spec: Optional[str]):
     from unicross.gaits import make_gait_policy
     gait = make_gait_policy(spec)
     return lambda task: gait(None, task)
-
-
-def residual_action(base: torch.Tensor, action: torch.Tensor) -> torch.Tensor:
-    """The env's action under ``model.base_policy``: the base gait's action plus the network's,
-    clipped to the action box (the env would clip it too)."""
-    return (base + action).clamp(-1.0, 1.0)
 
 
 def check_teacher(spec: Optional[str], skill: str, axis: Optional[str], backend: str,

@@ -97,11 +97,17 @@ def act(policy, obs: dict, deterministic: bool = True) -> torch.Tensor:
 def actor_action(actor, obs: dict, deterministic: bool = True, base=None) -> torch.Tensor:
     """:func:`act` for the bare network ``(hand, object, goal) -> (loc, scale)``; with ``base`` (the
     action of the policy's base gait, ``model.base_policy``) the network's action is added to it
-    before the clip, as in training (:func:`unicross.rl.collector.residual_action`)."""
+    before the clip, as in training (:func:`residual_action`)."""
     loc, scale = actor(*split_obs(obs))
     if not deterministic:
         loc = loc + scale * torch.randn_like(loc)
-    return loc.clamp(-1.0, 1.0) if base is None else (base + loc).clamp(-1.0, 1.0)
+    return loc.clamp(-1.0, 1.0) if base is None else residual_action(base, loc)
+
+
+def residual_action(base: torch.Tensor, action: torch.Tensor) -> torch.Tensor:
+    """The env's action under ``model.base_policy``: the base gait's action plus the network's,
+    clipped to the action box (the env would clip it too)."""
+    return (base + action).clamp(-1.0, 1.0)
 
 
 def base_policy_of(ck: dict):
