@@ -41,6 +41,9 @@ def test_report_paper_one_trial(tmp_path):
     assert f"| relocate | zero | {_cell(E.summarize('relocate', trials), 'relocate')} |" in text
     for mode in ("rotate_x+", "rotate_z-", "translate_z+", "translate_z-"):  # the bar of each in-hand expert
         assert f"| {mode} | zero | " in text
+    n_rot = sum(m.startswith("rotate") for m in ships)
+    if n_rot:  # the issue's rotate target is read off one pooled line under the experts' table
+        assert f"Rotate, pooled over the {n_rot} axes with an expert (of 6): " in text
 
 
 def test_report_raises_trials_to_the_minimum():
@@ -78,8 +81,13 @@ def test_a_checkpoint_on_top_of_a_gait_is_named_so_in_the_tables(tmp_path):
     import torch
     from unicross.report import policy_label
     from unicross.rl.policy_io import read_torch_file, resolve_checkpoint
-    assert policy_label("allegro/rotate_y-") == "allegro/rotate_y-"
+    assert policy_label("allegro/grasp") == "allegro/grasp"
     ck = read_torch_file(resolve_checkpoint("allegro/rotate_y-"), "checkpoint")
+    ck.pop("clone_of", None)
+    torch.save(ck, tmp_path / "plain.pt")
+    assert policy_label(str(tmp_path / "plain.pt")) == str(tmp_path / "plain.pt")
     ck["config"] = dict(ck["config"], model=dict(ck["config"]["model"], base_policy="allegro/rotate_y-"))
     torch.save(ck, tmp_path / "r.pt")
     assert policy_label(str(tmp_path / "r.pt")) == f"{tmp_path / 'r.pt'} (PPO on top of gait:allegro/rotate_y-)"
+    # a network cloned from a gait (benchmarks/gait_clone.py records its gait) is not called a PPO expert
+    assert policy_label("allegro/rotate_y-") == "allegro/rotate_y- (DAgger clone of gait:allegro/rotate_y-, not PPO)"

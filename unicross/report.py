@@ -41,10 +41,16 @@ def shipped(hand: str = "allegro") -> Dict[str, str]:
 
 def policy_label(spec: str) -> str:
     """A checkpoint's name in the tables, saying so when it acts on top of a scripted gait
-    (``model.base_policy``)."""
+    (``model.base_policy``) or is a network cloned from one (``clone_of``, written by
+    ``benchmarks/gait_clone.py``) rather than a PPO expert."""
     from unicross.rl.policy_io import base_policy_of, read_torch_file, resolve_checkpoint
-    base = base_policy_of(read_torch_file(resolve_checkpoint(spec), "checkpoint"))
-    return spec if base is None else f"{spec} (PPO on top of gait:{base})"
+    ck = read_torch_file(resolve_checkpoint(spec), "checkpoint")
+    base = base_policy_of(ck)
+    if base is not None:
+        return f"{spec} (PPO on top of gait:{base})"
+    if ck.get("clone_of"):
+        return f"{spec} (DAgger clone of gait:{ck['clone_of']}, not PPO)"
+    return spec
 
 
 def _paper(setting: str, skill: str) -> str:
@@ -134,8 +140,13 @@ class PaperReport:
                  f"(`configs/eval.yaml`). Paper values: the full test set x 25 trials.", ""]
         self.log("experts on test objects ...")
         lines += self._table("Experts, held-out test objects", self._per_mode("test", False, "expert"), "Experts")
+        lines += self._rotate_pooled([(m, spec, "test", False) for m, spec in self.ckpts.items() if m != "student"],
+                                     "an expert", "Experts")
         self.log("student on test objects ...")
         lines += self._table("Student, held-out test objects", self._per_mode("test", False, "student"), "Ours")
+        if "student" in self.ckpts:
+            lines += self._rotate_pooled([(m, self.ckpts["student"], "test", False) for m in self.student_modes],
+                                         "a distilled student", "Ours")
         self.log("unseen objects ...")
         lines += self._table("Unseen objects (spheres, hexagonal and octagonal prisms)",
                              self._per_mode("unseen", False, "expert"), "Uns.",
@@ -166,7 +177,6 @@ class PaperReport:
     def _gait_tables(self) -> List[str]:
         """The shipped scripted gaits (:mod:`unicross.gaits`) on test and unseen objects, and the
         success rate pooled over the rotate axes (the issue's "averaged over the six axes")."""
-        from unicross.metrics import wilson_interval
         lines = []
         for objects, title, setting in (("test", "held-out test objects", "Experts"),
                                         ("unseen", "unseen objects", "Uns.")):
@@ -178,17 +188,24 @@ class PaperReport:
                 "(`benchmarks/gait_search.py --hold`), run until the object has turned past the success angle "
                 "(read from the task's state), then holding still: a scripted reference, not a learned policy. "
                 "Rot. stays near the success angle by design (the paper's policies keep turning for 400 steps).")
-            rot = [self.summaries.get((m, f"gait:{s}", objects, False)) for m, s in self.gaits.items()
-                   if skill_of_mode(m).name == "rotate"]
-            rot = [r for r in rot if r]
-            if rot:
-                k, n = sum(r["successes"] for r in rot), sum(r["n"] for r in rot)
-                lo, hi = wilson_interval(k, n)
-                lines += [f"Rotate, pooled over the {len(rot)} axes with a gait (of 6): "
-                          f"{100 * k / n:.1f} [{100 * lo:.1f}-{100 * hi:.1f}] (n={n}); the issue's target for "
-                          f"the experts: >= 50% averaged over the six axes (paper {PAPER[setting]['rotate'][0]:.1f}).",
-                          ""]
+            lines += self._rotate_pooled([(m, f"gait:{s}", objects, False) for m, s in self.gaits.items()],
+                                         "a gait", setting)
         return lines
+
+    def _rotate_pooled(self, cells: List[tuple], what: str, setting: str) -> List[str]:
+        """One line: the success rate pooled over the rotate cells among ``cells`` (keys of
+        :attr:`summaries`: (mode, spec, objects, disturb)) with its interval, beside the issue's
+        target (>= 50% averaged over the six axes; pooled equals averaged when the axes have equal n)."""
+        from unicross.metrics import wilson_interval
+        rot = [self.summaries.get(c) for c in cells if skill_of_mode(c[0]).name == "rotate"]
+        rot = [r for r in rot if r]
+        if not rot:
+            return []
+        k, n = sum(r["successes"] for r in rot), sum(r["n"] for r in rot)
+        lo, hi = wilson_interval(k, n)
+        return [f"Rotate, pooled over the {len(rot)} axes with {what} (of 6): "
+                f"{100 * k / n:.1f} [{100 * lo:.1f}-{100 * hi:.1f}] (n={n}); the issue's target for "
+                f"the experts: >= 50% averaged over the six axes (paper {PAPER[setting]['rotate'][0]:.1f}).", ""]
 
     def _long_horizon(self) -> List[str]:
         from unicross.evaluation import (chain_last_phase_by_mode, chain_table, run_chain, summarize_chain,
