@@ -82,21 +82,36 @@ def is_dagger(run: Path) -> bool:
 
 
 def plot_dagger(runs, fig, a, b, args) -> int:
-    for run in runs:
-        rows = [json.loads(line) for line in (run / "metrics.jsonl").read_text().splitlines() if line.strip()]
-        modes = sorted({k.split("/", 1)[1] for r in rows for k in r if k.startswith("mse/")})
+    """One colour per mode, one line style per run (seeds), and a legend of each."""
+    from matplotlib.lines import Line2D
+    styles = ["-", "--", ":", "-."]
+    data = [[json.loads(line) for line in (run / "metrics.jsonl").read_text().splitlines() if line.strip()]
+            for run in runs]
+    modes = sorted({k.split("/", 1)[1] for rows in data for r in rows for k in r if k.startswith("mse/")})
+    colour = {m: f"C{i % 10}" for i, m in enumerate(modes)}
+    for j, rows in enumerate(data):
+        ls = styles[j % len(styles)]
         for m in modes:
             pts = [(r["frames"], r[f"mse/{m}"]) for r in rows if f"mse/{m}" in r]
-            a.plot([f for f, _ in pts], [v for _, v in pts], label=f"{run.name} {m}")
+            a.plot([f for f, _ in pts], [v for _, v in pts], color=colour[m], ls=ls, lw=1)
             pts = [(r["frames"], 100 * r[f"success/{m}"]) for r in rows if f"success/{m}" in r]
-            b.plot([f for f, _ in pts], smooth([v for _, v in pts], 25), label=f"{run.name} {m}")
+            b.plot([f for f, _ in pts], smooth([v for _, v in pts], 25), color=colour[m], ls=ls, lw=1)
     a.set(xlabel="frames", ylabel="action MSE to the expert", yscale="log", title="distillation loss per mode")
     b.set(xlabel="frames", ylabel="success (%), smoothed", ylim=(-2, 102),
           title="student's training episodes (randomised, perturbed)")
+    handles = [Line2D([], [], color=colour[m], label=m) for m in modes]
+    if len(runs) > 1:
+        handles += [Line2D([], [], color="k", ls=styles[j % len(styles)], label=run.name) for j, run in enumerate(runs)]
     for ax in (a, b):
         ax.grid(alpha=0.3)
-        ax.legend(fontsize=8)
-    return save(fig, args)
+    fig.legend(handles=handles, loc="center right", fontsize=8)
+    fig.subplots_adjust(right=0.8)
+    if args.title:
+        fig.suptitle(args.title)
+    Path(args.out).parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(args.out, dpi=110)
+    print(f"wrote {args.out}")
+    return 0
 
 
 if __name__ == "__main__":
