@@ -100,6 +100,9 @@ def main(argv=None) -> int:
     ap.add_argument("--batch", type=int, default=512)
     ap.add_argument("--lr", type=float, default=1e-3)
     ap.add_argument("--weight-decay", type=float, default=0.0, help="AdamW's decoupled weight decay (0: Adam)")
+    ap.add_argument("--obs-std-min", type=float, default=None,
+                    help="model.obs_std_min of the network (floor of the std its inputs are divided by; "
+                         "default: configs/ppo.yaml's); stored in the checkpoint")
     ap.add_argument("--beta", type=float, default=0.0,
                     help="DAgger's mixture: in round r the gait acts at beta**r of the network's steps (0: never)")
     ap.add_argument("--privileged-q0", action="store_true",
@@ -124,6 +127,10 @@ def main(argv=None) -> int:
     mode = gait_mode(make_gait_policy(args.gait).gait_row)  # a bad gait or option fails before any simulation
     skill, axis = mode.split("_")
     cfg = load_config("ppo")
+    if args.obs_std_min is not None:
+        if args.obs_std_min < 0:
+            ap.error("--obs-std-min must be >= 0")
+        cfg["model"]["obs_std_min"] = args.obs_std_min
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     torch.manual_seed(args.seed)

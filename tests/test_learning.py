@@ -172,6 +172,35 @@ def test_untrained_policy_acts_near_zero_and_normaliser_skips_nonfinite_rows():
     assert torch.allclose(out["state_value"], value.value_norm(out["state_value_norm"]))
 
 
+def test_obs_std_floor_keeps_a_barely_varying_feature_off_the_clip_and_travels_with_the_checkpoint(tmp_path):
+    """A feature that stayed still in the fitted data (std ~1e-4) reaches the clip at a 1 cm change
+    without ``model.obs_std_min``; with a floor of 1e-2 it reads ~1, the rest unchanged; a saved
+    policy rebuilds with its floor (old checkpoints, without the key, keep none)."""
+    from unicross.config import load_config
+    from unicross.rl.models import make_models
+    from unicross.rl.policy_io import load_policy
+    dims = dict(hand=4, object=3, goal=55)
+    cfg = load_config("ppo")
+    assert cfg["model"]["obs_std_min"] == 0.0
+    data = {k: torch.randn(256, d) for k, d in dims.items()}
+    data["hand"][:, 0] = 0.5 + 1e-4 * torch.randn(256)
+    x = {k: v[:2].clone() for k, v in data.items()}
+    x["hand"][:, 0] = 0.51
+    outs = {}
+    for floor in (0.0, 1e-2):
+        cfg["model"]["obs_std_min"] = floor
+        policy, _, norm = make_models(dims, 5, None, cfg["model"])
+        norm.update(data)
+        outs[floor] = norm("hand", x["hand"])
+        path = tmp_path / f"p{floor}.pt"
+        torch.save(dict(policy=policy.state_dict(), obs_dims=dims, n_act=5, hand="allegro", config=cfg, skill="grasp"), path)
+        loaded, _ = load_policy(path)
+        assert loaded.module[0].module.net.norm.std_min == floor
+    assert outs[0.0][:, 0].abs().min() == 5.0  # clipped
+    assert torch.allclose(outs[1e-2][:, 0], torch.full((2,), 1.0), atol=0.1)
+    assert torch.allclose(outs[0.0][:, 1:], outs[1e-2][:, 1:])  # features that vary are untouched
+
+
 def test_shipped_grasp_expert_lifts_a_held_out_object():
     """The shipped expert (unicross/checkpoints/allegro/grasp.pt, by its shorthand) grasps and lifts
     a test object it never trained on, under the paper's grasp protocol."""

@@ -47,9 +47,14 @@ def merge_moments(mean: torch.Tensor, var: torch.Tensor, count: torch.Tensor, x:
 
 class ObsNormalizer(nn.Module):
     """Running mean/variance per observation group; ``update`` is called by the trainer on each
-    collected batch (after the update that used the previous statistics)."""
+    collected batch (after the update that used the previous statistics).
 
-    def __init__(self, dims: dict, clip: float = 5.0):
+    ``std_min`` floors the standard deviation a feature is divided by (``model.obs_std_min``). A
+    feature that barely varied in the data the statistics came from (the wrist command while a gait
+    holds the wrist still: std ~1e-4) otherwise turns a millimetre's difference into the clip value
+    +-5, and a network fitted there answers such states from saturated inputs."""
+
+    def __init__(self, dims: dict, clip: float = 5.0, std_min: float = 0.0):
         super().__init__()
         self.keys = list(dims)
         for k, d in dims.items():
@@ -57,6 +62,7 @@ class ObsNormalizer(nn.Module):
             self.register_buffer(f"{k}_var", torch.ones(d))
         self.register_buffer("count", torch.tensor(1e-4))
         self.clip = clip
+        self.std_min = float(std_min)
 
     @torch.no_grad()
     def update(self, batch: dict) -> int:
@@ -74,7 +80,7 @@ class ObsNormalizer(nn.Module):
 
     def forward(self, key: str, x: torch.Tensor) -> torch.Tensor:
         m, v = getattr(self, f"{key}_mean"), getattr(self, f"{key}_var")
-        return ((x - m) / torch.sqrt(v + 1e-8)).clamp(-self.clip, self.clip)
+        return ((x - m) / torch.sqrt(v + 1e-8).clamp_min(self.std_min)).clamp(-self.clip, self.clip)
 
 
 class UniCrossNet(nn.Module):
@@ -159,7 +165,7 @@ def make_models(dims: dict, n_act: int, action_spec=None, cfg: dict | None = Non
     is the first of the two modules (what the critic loss trains)."""
     cfg = cfg or {}
     enc, main = tuple(cfg.get("encoder_hidden", (128, 64))), tuple(cfg.get("main_hidden", (512, 256, 128)))
-    norm = ObsNormalizer(dims)
+    norm = ObsNormalizer(dims, std_min=cfg.get("obs_std_min", 0.0))
     actor = GaussianHead(UniCrossNet(dims, n_act, norm, enc, main), n_act, cfg.get("init_log_std", -0.5),
                          cfg.get("action_init_scale", 1.0), cfg.get("init_log_std_wrist"))
     policy = ProbabilisticActor(
