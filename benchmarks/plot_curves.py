@@ -66,10 +66,11 @@ def main(argv=None) -> int:
     return save(fig, args)
 
 
-def save(fig, args) -> int:
+def save(fig, args, rect=(0, 0, 1, 1)) -> int:
+    """Writes the figure; ``rect``: the part of it the axes fill (room for a figure legend)."""
     if args.title:
         fig.suptitle(args.title)
-    fig.tight_layout()
+    fig.tight_layout(rect=rect)
     Path(args.out).parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(args.out, dpi=110)
     print(f"wrote {args.out}")
@@ -105,13 +106,7 @@ def plot_dagger(runs, fig, a, b, args) -> int:
     for ax in (a, b):
         ax.grid(alpha=0.3)
     fig.legend(handles=handles, loc="center right", fontsize=8)
-    fig.subplots_adjust(right=0.8)
-    if args.title:
-        fig.suptitle(args.title)
-    Path(args.out).parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(args.out, dpi=110)
-    print(f"wrote {args.out}")
-    return 0
+    return save(fig, args, rect=(0, 0, 0.83, 1))
 
 
 if __name__ == "__main__":

@@ -76,16 +76,11 @@ def main(argv=None) -> int:
             p.error(f"--relabel takes MODE=POLICY with MODE in {list(F.MODES)}, got {spec!r}")
         relabel[mode] = path
     data, ck = load_buffer(Path(a.run))
-    for mode, path in relabel.items():
-        from unicross.rl.policy_io import load_policy
-        teacher, _ = load_policy(path)
-        head = teacher.module[0].module
-        sel = torch.nonzero(data["mode"] == F.MODES.index(mode)).flatten()
-        with torch.no_grad():
-            for i in range(0, len(sel), 16384):
-                idx = sel[i: i + 16384]
-                loc, _ = head(*(data[k][idx] for k in OBS_KEYS))
-                data["expert_action"][idx] = loc.clamp(-1.0, 1.0)
+    if relabel:  # DAgger's own labelling: each mode's checkpoint checked and its action clamped
+        from unicross.rl.dagger import Teachers
+        teachers = Teachers({m: Path(path) for m, path in relabel.items()}, "cpu")
+        sel = torch.isin(data["mode"], torch.tensor([F.MODES.index(m) for m in relabel]))
+        data["expert_action"][sel] = teachers(data[sel])
     n = data.shape[0]
     perm = torch.randperm(n)
     n_test = int(n * a.holdout)
