@@ -216,7 +216,8 @@ def main(argv=None) -> int:
     ck = dict(policy=fitted[best]["state"], obs_dims=dims, n_act=labels.shape[-1], modes=list(F.MODES), config=cfg,
               skill=skill, axis=axis, hand=args.hand, env_id=R.skill(skill).env_id,
               env_kwargs=env_kwargs_for(skill, axis, args.hand, cfg["env"]), iteration=0, frames=0,
-              git_commit=git_commit(), commits=[git_commit()], clone_of=args.gait)
+              git_commit=git_commit(), commits=[git_commit()], clone_of=args.gait,
+              wall_s=round(time.time() - t0, 1))
     diagnosis = args.privileged_q0 or args.clock
     if not diagnosis:
         torch.save(ck, out / "policy.pt")

@@ -255,6 +255,8 @@ def _cmd_export(args) -> int:
     from unicross.rl.policy_io import read_torch_file
     ck = read_torch_file(ckpt, "checkpoint")
     sidecar["train_wall_s"] = round(float(ck.get("wall_s", 0.0)), 1)
+    if ck.get("clone_of"):  # benchmarks/gait_clone.py: a network fitted to a scripted gait, not PPO
+        sidecar["kind"] = "dagger clone of a scripted gait"
     for f in args.eval or []:
         e = json.loads(Path(f).read_text())
         sidecar.setdefault("evaluations", []).append(dict(file=str(f), objects=e.get("objects"), limit=e.get("limit"),
