@@ -251,7 +251,7 @@ def test_shipped_rotate_policy_turns_a_held_out_object():
     """The shipped rotate y- policy (allegro/rotate_y-: a network cloned from the scripted gait,
     acting from the observation alone) turns a held test object past pi/2 about the hand's y- axis
     without dropping it, where the zero action turns none (first two test objects, 3 trials each:
-    the start of the recorded held-out evaluation, 2 of those 6 succeeded there)."""
+    the start of the recorded held-out evaluation, 1 of those 6 succeeded there)."""
     from unicross.objects import get_object_set
     trials, zero = _shipped_and_zero("allegro/rotate_y-", "rotate", "y-", get_object_set("test", limit=20)[:2],
                                      trials_per_object=3)
