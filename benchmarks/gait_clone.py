@@ -39,7 +39,8 @@ from unicross import formulation as F
 
 
 def _rollouts(gait: str, hand: str, objects: str, limit: int, trials: int, seed: int, randomize: bool,
-              student, shard, beta: float = 0.0, privileged_q0: bool = False, clock: bool = False) -> tuple:
+              student, shard, beta: float = 0.0, privileged_q0: bool = False, clock: bool = False,
+              history: bool = False) -> tuple:
     """One worker's share: (obs dict of [N, d], labels [N, A], trials) of the rotate protocol on its
     objects, the gait acting (``student`` None) or the student's mean acting while the gait labels;
     with ``beta`` > 0 the gait's own action is taken instead at that fraction of the steps (each env
@@ -59,10 +60,16 @@ def _rollouts(gait: str, hand: str, objects: str, limit: int, trials: int, seed:
     mix = torch.Generator().manual_seed(seed + 104729 * shard[0])
 
     q0 = {}
+    prev = {}
 
     def policy(obs, u):
         label = teacher(obs, u)
         parts = split_obs(obs)
+        if history:  # diagnosis only: the previous control step's s^h appended (the step's own at t = 0)
+            now = parts[0]
+            before = now if int(u.elapsed_steps[0]) == 0 else prev["h"]
+            prev["h"] = now.clone()
+            parts = (torch.cat([now, before], -1),) + tuple(parts[1:])
         if privileged_q0:  # diagnosis only: the episode's start command appended to the hand state
             if int(u.elapsed_steps[0]) == 0:
                 q0["q"] = u.command[:, 6:].clone()
@@ -111,6 +118,10 @@ def main(argv=None) -> int:
     ap.add_argument("--clock", action="store_true",
                     help="diagnosis only: the network also sees the gait's clock (sin and cos of its phase at the "
                          "control step); its checkpoint does not fit the UniCross observation and is not written")
+    ap.add_argument("--history", action="store_true",
+                    help="diagnosis only: the network also sees the previous control step's s^h (joint readings "
+                         "and command), as HORA's proprioceptive history; its checkpoint does not fit the UniCross "
+                         "observation and is not written")
     ap.add_argument("--randomize", action="store_true", help="training's randomisation (default: the evaluation's conditions)")
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--seed", type=int, default=0)
@@ -152,7 +163,7 @@ def main(argv=None) -> int:
             parts = [f.result() for f in [ex.submit(_rollouts, args.gait, args.hand, args.objects, args.limit,
                                                      args.trials, args.seed + 7919 * r, args.randomize, student,
                                                      (i, args.workers), beta_of(r), args.privileged_q0,
-                                                     args.clock)
+                                                     args.clock, args.history)
                                            for i in range(args.workers)]]
         o = {k: torch.cat([p[0][k] for p in parts]) for k in parts[0][0]}
         y = torch.cat([p[1] for p in parts])
@@ -215,10 +226,11 @@ def main(argv=None) -> int:
     log.append(dict(kept_round=best, success=fitted[best]["success"]))
     ck = dict(policy=fitted[best]["state"], obs_dims=dims, n_act=labels.shape[-1], modes=list(F.MODES), config=cfg,
               skill=skill, axis=axis, hand=args.hand, env_id=R.skill(skill).env_id,
-              env_kwargs=env_kwargs_for(skill, axis, args.hand, cfg["env"]), iteration=0, frames=0,
+              env_kwargs=env_kwargs_for(skill, axis, args.hand, cfg["env"]), iteration=0,
+              frames=sum(row.get("new_states", 0) for row in log),  # every control step simulated, all rounds
               git_commit=git_commit(), commits=[git_commit()], clone_of=args.gait,
               wall_s=round(time.time() - t0, 1))
-    diagnosis = args.privileged_q0 or args.clock
+    diagnosis = args.privileged_q0 or args.clock or args.history
     if not diagnosis:
         torch.save(ck, out / "policy.pt")
     with open(out / "log.jsonl", "w") as f:

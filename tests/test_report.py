@@ -14,7 +14,7 @@ def test_report_paper_one_trial(tmp_path):
     text = out.read_text()
     assert text.splitlines()[2].startswith("Command: `unicross report") and "--min-trials 0" in text.splitlines()[2]
     for title in ("Experts, held-out test objects", "Student, held-out test objects", "Unseen objects",
-                  "Disturbances", "Baselines", "Long horizon"):
+                  "Disturbances", "Baselines", "Training budget of the shipped checkpoints", "Long horizon"):
         assert f"## {title}" in text
     assert "In-hand phase by mode: " in text
     n_test = len(get_object_set("test", limit=1))
@@ -91,3 +91,26 @@ def test_a_checkpoint_on_top_of_a_gait_is_named_so_in_the_tables(tmp_path):
     assert policy_label(str(tmp_path / "r.pt")) == f"{tmp_path / 'r.pt'} (PPO on top of gait:allegro/rotate_y-)"
     # a network cloned from a gait (benchmarks/gait_clone.py records its gait) is not called a PPO expert
     assert policy_label("allegro/rotate_y-") == "allegro/rotate_y- (DAgger clone of gait:allegro/rotate_y-, not PPO)"
+
+
+def test_training_budget_reads_every_shipped_sidecar():
+    """One row per shipped checkpoint with the frames and wall-clock its sidecar records, and how it
+    was made read from the checkpoint (a clone or the student is not called PPO)."""
+    import json
+    from unicross.report import CHECKPOINTS, PAPER_FRAMES_PER_EXPERT, how_trained, shipped, training_budget
+    lines = training_budget("allegro")
+    rows = [r for r in lines if r.startswith("| allegro/")]
+    assert len(rows) == len(shipped("allegro"))
+    for name, spec in shipped("allegro").items():
+        side = json.loads((CHECKPOINTS / "allegro" / f"{name}.json").read_text())
+        row = next(r for r in rows if r.startswith(f"| {spec} |"))
+        if side.get("frames"):
+            assert f"| {side['frames']:,} |" in row
+            if name != "student":
+                assert row.endswith(f"| {side['frames'] / PAPER_FRAMES_PER_EXPERT:.1e} |")
+        if side.get("train_wall_s"):
+            assert f"| {side['train_wall_s'] / 60:.0f} min |" in row
+    assert how_trained({"distilled_modes": ["grasp", "relocate"]}, {}) == "DAgger student of 2 experts"
+    assert how_trained({"clone_of": "allegro/rotate_y-"}, {}).startswith("DAgger clone of gait:allegro/rotate_y-")
+    assert how_trained({"config": {"model": {"init_reference": 0.75}}}, {}).startswith("PPO from a scripted start")
+    assert how_trained({"config": {"model": {}}}, {}) == "PPO"
