@@ -266,3 +266,35 @@ def test_a_residual_rollout_steps_the_env_with_the_gait_plus_the_network():
     assert (data["teacher_action"][:, :, 6:] + data["action"][:, :, 6:]).abs().max() > 1.0  # the clip is exercised
     with pytest.raises(ValueError, match="base gait"):
         C.Rollout(R_ID, dict(kw, num_envs=1, sim_backend="physx_cpu"), seed=0, residual=True)
+
+
+def test_a_rollout_stores_what_stepping_the_env_by_hand_gives():
+    """Every stored key of a rollout (observations, rewards, flags, info terms) equals a replay of
+    its actions on a fresh ``state_dict`` env of the same seed, across an episode boundary: the
+    flat observation's views and the stacking at the end of ``collect`` change nothing."""
+    import gymnasium as gym
+    from unicross.rl.env import INFO_BOOL, info_float_keys, split_obs
+    ro = C.Rollout("UniCross-Grasp-v1", KW, seed=11)
+    policy, _ = _models(ro)
+    ro.set_actor(policy.module[0].module)
+    buf = C.make_buffer(1, 70, ro.dims, ro.n_act)
+    ro.collect(buf)
+    ro.close()
+    env = gym.make("UniCross-Grasp-v1", obs_mode="state_dict", render_backend="none", **KW)
+    try:
+        obs, _ = env.reset(seed=11)
+        for t in range(70):
+            for k, x in zip(C.OBS_KEYS, split_obs(obs)):
+                assert torch.equal(buf[k][:, t], x), (t, k)
+            obs, reward, terminated, truncated, info = env.step(buf["action"][:, t])
+            for k, x in zip(C.OBS_KEYS, split_obs(obs)):
+                assert torch.equal(buf["next", k][:, t], x), (t, k)
+            assert torch.equal(buf["next", "reward"][:, t, 0], reward)
+            assert torch.equal(buf["next", "done"][:, t, 0], terminated | truncated)
+            for k in info_float_keys() + INFO_BOOL:
+                assert torch.equal(buf["next", "info", k][:, t, 0], info[k].to(buf["next", "info", k].dtype)), (t, k)
+            if bool((terminated | truncated).any()):
+                obs, _ = env.reset()
+        assert bool(buf["next", "done"][0, 63, 0])  # the replay crossed an episode boundary
+    finally:
+        env.close()

@@ -36,7 +36,7 @@ import torch
 import torch.multiprocessing as mp
 from tensordict import TensorDict
 
-from unicross.rl.env import INFO_BOOL, info_float_keys, split_obs
+from unicross.rl.env import INFO_BOOL, info_float_keys, obs_splitter
 from unicross.rl.policy_io import residual_action
 
 OBS_KEYS = ("hand", "object", "goal")
@@ -112,9 +112,10 @@ class Rollout:
         import gymnasium as gym
         import unicross  # noqa: F401  (registers the tasks)
         kw = dict(render_backend="none", **env_kwargs)
-        kw["obs_mode"] = "state_dict"
+        kw["obs_mode"] = "state"  # flat: the three groups are views of it (obs_splitter)
         self._gym = gym.make(env_id, **kw)
         self.task = self._gym.unwrapped
+        self._split = obs_splitter(self.task._obs_layout)
         self.actor: Optional[torch.nn.Module] = None
         self.deterministic = deterministic
         self.device = self.task.device
@@ -127,7 +128,7 @@ class Rollout:
             raise ValueError("a residual rollout needs its base gait (teacher)")
         self.residual = residual
         obs, _ = self.task.reset(seed=seed)
-        self.obs = split_obs(obs)
+        self.obs = self._split(obs)
         self.dims = {k: x.shape[-1] for k, x in zip(OBS_KEYS, self.obs)}
         self.n_act = int(self.task.single_action_space.shape[0])
 
@@ -136,47 +137,58 @@ class Rollout:
 
     @torch.no_grad()
     def collect(self, buf: TensorDict) -> None:
-        """Fills ``buf`` [num_envs, T] (plain tensor writes, no TensorDict work per step)."""
+        """Fills ``buf`` [num_envs, T]. The step loop only keeps references to each step's tensors
+        (every one a fresh output of the actor or the task's step); they are stacked into the buffer
+        once per key at the end, ~30 copies per rollout instead of per step."""
         leaves = {k: buf.get(k) for k in buf.keys(include_nested=True, leaves_only=True)}
-        nxt_obs = [leaves[("next", k)] for k in OBS_KEYS]
-        obs_buf = [leaves[k] for k in OBS_KEYS]
-        info_keys = [(k, leaves[("next", "info", k)]) for k in info_float_keys() + INFO_BOOL]
-        act, logp, loc_b, scale_b = leaves["action"], leaves["action_log_prob"], leaves["loc"], leaves["scale"]
-        rew, done_b = leaves[("next", "reward")], leaves[("next", "done")]
-        term_b, trunc_b = leaves[("next", "terminated")], leaves[("next", "truncated")]
-        half_log_2pi = 0.5 * math.log(2 * math.pi)
-        teacher_b = leaves.get("teacher_action") if self.teacher is not None else None
-        for t in range(buf.shape[1]):
-            for dst, x in zip(obs_buf, self.obs):
-                dst[:, t] = x
+        info_names = info_float_keys() + INFO_BOOL
+        horizon = buf.shape[1]
+        obs_s, nxt_s, info_s, rew_s, term_s, trunc_s = [], [], [], [], [], []
+        act_s, loc_s, scale_s, noise_s, teacher_s = [], [], [], [], []
+        for _ in range(horizon):
+            obs_s.append(self.obs)
             base = None
-            if teacher_b is not None:
-                teacher_b[:, t] = base = self.teacher(self.task)
+            if self.teacher is not None:
+                base = self.teacher(self.task)
+                teacher_s.append(base)
             loc, scale = self.actor(*self.obs)
             noise = torch.zeros_like(loc) if self.deterministic else self._noise(loc.shape)
             a = loc + scale * noise
-            act[:, t], loc_b[:, t], scale_b[:, t] = a, loc, scale
-            logp[:, t] = (-0.5 * noise ** 2 - scale.log() - half_log_2pi).sum(-1)
+            act_s.append(a), loc_s.append(loc), scale_s.append(scale), noise_s.append(noise)
             obs, reward, terminated, truncated, info = self.task.step(residual_action(base, a) if self.residual else a)
-            nxt = split_obs(obs)
-            for dst, x in zip(nxt_obs, nxt):
-                dst[:, t] = x
-            rew[:, t, 0] = reward
-            term_b[:, t, 0], trunc_b[:, t, 0] = terminated, truncated
+            nxt = self._split(obs)
+            nxt_s.append(nxt)
+            rew_s.append(reward), term_s.append(terminated), trunc_s.append(truncated)
+            info_s.append([info[k] for k in info_names])
             done = terminated | truncated
-            done_b[:, t, 0] = done
-            for k, dst in info_keys:
-                dst[:, t, 0] = info[k]
             if bool(done.any()):
                 options = {} if self.task.num_envs == 1 else {"env_idx": torch.nonzero(done).flatten()}
                 obs, _ = self.task.reset(options=options)
-                fresh = split_obs(obs)
+                fresh = self._split(obs)
                 nxt = fresh if self.task.num_envs == 1 else \
                     tuple(torch.where(done[:, None], f, x) for f, x in zip(fresh, nxt))
                 if self.eps is not None:  # a new episode starts its noise from the stationary law
                     self.eps = torch.where(done[:, None], torch.randn(self.eps.shape, generator=self.gen,
                                                                       device=self.eps.device), self.eps)
             self.obs = nxt
+
+        def put(dst: torch.Tensor, steps: list) -> None:  # [N, ...] per step -> dst [N, T, ...]
+            dst.copy_(torch.stack(steps, dim=1).view(dst.shape))
+
+        for i, k in enumerate(OBS_KEYS):
+            put(leaves[k], [o[i] for o in obs_s])
+            put(leaves[("next", k)], [o[i] for o in nxt_s])
+        for k, steps in (("action", act_s), ("loc", loc_s), ("scale", scale_s), (("next", "reward"), rew_s),
+                         (("next", "terminated"), term_s), (("next", "truncated"), trunc_s)):
+            put(leaves[k], steps)
+        term, trunc = leaves[("next", "terminated")], leaves[("next", "truncated")]
+        torch.logical_or(term, trunc, out=leaves[("next", "done")])
+        noise, scale = torch.stack(noise_s, dim=1), leaves["scale"]
+        leaves["action_log_prob"].copy_((-0.5 * noise ** 2 - scale.log() - 0.5 * math.log(2 * math.pi)).sum(-1))
+        for j, k in enumerate(info_names):
+            put(leaves[("next", "info", k)], [s[j] for s in info_s])
+        if teacher_s:
+            put(leaves["teacher_action"], teacher_s)
 
     def _noise(self, shape) -> torch.Tensor:
         white = torch.randn(shape, generator=self.gen, device=self.device)

@@ -37,6 +37,17 @@ def split_obs(obs: dict) -> tuple:
     return o["hand"], obj, o["goal"]
 
 
+def obs_splitter(layout: list):
+    """``obs -> (hand, object, goal)`` for a UniCross ``state`` observation [N, D] with the task's
+    ``_obs_layout``: three views, no copy (the object terms lie side by side in the flat observation,
+    so its group needs no ``cat``); the same tensors as :func:`split_obs` of the ``state_dict`` one."""
+    widths = [w if isinstance(w, int) else sum(x for _, x in w) for _, w in layout]
+
+    def split(flat: torch.Tensor) -> tuple:
+        return tuple(torch.split(flat, widths, dim=-1))
+    return split
+
+
 def obs_to_td(obs: dict, device=None) -> TensorDict:
     """A UniCross ``state_dict`` observation -> TensorDict with keys hand, object, goal ([N, ...])."""
     hand, obj, goal = split_obs(obs)
