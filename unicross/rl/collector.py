@@ -139,7 +139,8 @@ class Rollout:
     def collect(self, buf: TensorDict) -> None:
         """Fills ``buf`` [num_envs, T]. The step loop only keeps references to each step's tensors
         (every one a fresh output of the actor or the task's step); they are stacked into the buffer
-        once per key at the end, ~30 copies per rollout instead of per step."""
+        once per key at the end, ~30 copies per rollout instead of per step (so a rollout's tensors are
+        held twice at the end: on a GPU env of many sub-scenes, a long horizon's peak memory doubles)."""
         leaves = {k: buf.get(k) for k in buf.keys(include_nested=True, leaves_only=True)}
         info_names = info_float_keys() + INFO_BOOL
         horizon = buf.shape[1]
