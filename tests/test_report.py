@@ -110,7 +110,7 @@ def test_training_budget_reads_every_shipped_sidecar():
                 assert row.endswith(f"| {side['frames'] / PAPER_FRAMES_PER_EXPERT:.1e} |")
         if side.get("train_wall_s"):
             assert f"| {side['train_wall_s'] / 60:.0f} min |" in row
-    assert how_trained({"distilled_modes": ["grasp", "relocate"]}, {}) == "DAgger student of 2 experts"
-    assert how_trained({"clone_of": "allegro/rotate_y-"}, {}).startswith("DAgger clone of gait:allegro/rotate_y-")
-    assert how_trained({"config": {"model": {"init_reference": 0.75}}}, {}).startswith("PPO from a scripted start")
-    assert how_trained({"config": {"model": {}}}, {}) == "PPO"
+    assert how_trained({"distilled_modes": ["grasp", "relocate"]}) == "DAgger student of 2 experts"
+    assert how_trained({"clone_of": "allegro/rotate_y-"}).startswith("DAgger clone of gait:allegro/rotate_y-")
+    assert how_trained({"config": {"model": {"init_reference": 0.75}}}).startswith("PPO from a scripted start")
+    assert how_trained({"config": {"model": {}}}) == "PPO"

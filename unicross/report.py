@@ -41,35 +41,39 @@ def shipped(hand: str = "allegro") -> Dict[str, str]:
     return {n: f"{hand}/{n}" for n in names if (d / f"{n}.pt").exists()}
 
 
-def policy_label(spec: str) -> str:
-    """A checkpoint's name in the tables, saying so when it acts on top of a scripted gait
-    (``model.base_policy``) or is a network cloned from one (``clone_of``, written by
-    ``benchmarks/gait_clone.py``) rather than a PPO expert."""
-    from unicross.rl.policy_io import base_policy_of, read_torch_file, resolve_checkpoint
-    ck = read_torch_file(resolve_checkpoint(spec), "checkpoint")
+def _gait_origin(ck: dict):
+    """``("residual", gait)`` for a checkpoint that acts on top of a scripted gait
+    (``model.base_policy``), ``("clone", gait)`` for a network cloned from one (``clone_of``, written
+    by ``benchmarks/gait_clone.py``), else None."""
+    from unicross.rl.policy_io import base_policy_of
     base = base_policy_of(ck)
     if base is not None:
-        return f"{spec} (PPO on top of gait:{base})"
-    if ck.get("clone_of"):
-        return f"{spec} (DAgger clone of gait:{ck['clone_of']}, not PPO)"
-    return spec
+        return "residual", base
+    return ("clone", ck["clone_of"]) if ck.get("clone_of") else None
 
 
-def how_trained(ck: dict, sidecar: dict) -> str:
+def policy_label(spec: str) -> str:
+    """A checkpoint's name in the tables, saying so when it acts on top of a scripted gait or is a
+    network cloned from one rather than a PPO expert."""
+    from unicross.rl.policy_io import read_torch_file, resolve_checkpoint
+    origin = _gait_origin(read_torch_file(resolve_checkpoint(spec), "checkpoint"))
+    if origin is None:
+        return spec
+    how, gait = origin
+    return f"{spec} (PPO on top of gait:{gait})" if how == "residual" else f"{spec} (DAgger clone of gait:{gait}, not PPO)"
+
+
+def how_trained(ck: dict) -> str:
     """How a shipped checkpoint was made, from what it stores: a DAgger student, a network cloned
     from a scripted gait, PPO on top of a gait, PPO from a scripted start, or PPO."""
-    from unicross.rl.policy_io import base_policy_of
     if ck.get("distilled_modes"):
         return f"DAgger student of {len(ck['distilled_modes'])} experts"
-    if ck.get("clone_of"):
-        return f"DAgger clone of gait:{ck['clone_of']} (its search not counted)"
-    base = base_policy_of(ck)
-    if base is not None:
-        return f"PPO on top of gait:{base}"
+    origin = _gait_origin(ck)
+    if origin is not None:
+        how, gait = origin
+        return f"PPO on top of gait:{gait}" if how == "residual" else f"DAgger clone of gait:{gait} (its search not counted)"
     init = (ck.get("config") or {}).get("model", {}).get("init_reference")
-    if init:
-        return f"PPO from a scripted start (model.init_reference {init:g})"
-    return "PPO"
+    return f"PPO from a scripted start (model.init_reference {init:g})" if init else "PPO"
 
 
 def training_budget(hand: str = "allegro") -> List[str]:
@@ -94,9 +98,9 @@ def training_budget(hand: str = "allegro") -> List[str]:
         note = side.get("train_wall_note")
         wall_cell = f"{wall / 60:.0f} min" if wall else "not logged" + (f" (sidecar: {note.split(',')[0]})" if note else "")
         hw = side.get("hardware") or {}
-        hw_cell = f"{hw.get('cpus', '?')} CPU cores" + (f", {hw['gpu']}" if hw.get("gpu") else ", no GPU") if hw else "--"
+        hw_cell = f"{hw['cpus']} CPU cores" if hw.get("cpus") else "--"
         share = "--" if name == "student" or not frames else f"{frames / PAPER_FRAMES_PER_EXPERT:.1e}"
-        lines.append(f"| {spec} | {how_trained(ck, side)} | {f'{frames:,}' if frames else 'not logged'} | "
+        lines.append(f"| {spec} | {how_trained(ck)} | {f'{frames:,}' if frames else 'not logged'} | "
                      f"{wall_cell} | {hw_cell} | {share} |")
     return lines + [""]
 
