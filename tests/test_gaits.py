@@ -139,3 +139,31 @@ def test_gait_options_ride_in_the_spec(tmp_path):
     phase = make_gait_policy("allegro/rotate_y-,tracking=phase,lookahead=1.5")(None, u)
     assert torch.equal(phase, make_gait_policy("allegro/rotate_y-", tracking="phase", lookahead=1.5)(None, u))
     assert not torch.equal(phase, make_gait_policy("allegro/rotate_y-")(None, u))
+
+
+def test_a_reversed_gait_runs_the_same_loop_backwards_and_is_a_gait_for_the_opposite_direction():
+    """``reverse_gait``: offsets at t are the original's at -t (every finger, distal loop included),
+    reversing twice gives the gait back, and ``reverse=1`` names the opposite direction as its mode
+    and moves the fingers the other way round on a stand-in env."""
+    from unicross.gaits import gait_offsets, resolve_gait, reverse_gait
+    g = torch.Generator().manual_seed(1)
+    for _ in range(5):
+        p = torch.rand(NPAR, generator=g) * 2 - 1
+        q = reverse_gait(p)
+        t = torch.arange(0, 60, 0.25)
+        assert torch.allclose(gait_offsets(q, t), gait_offsets(p, -t), atol=1e-5)
+        assert not torch.allclose(gait_offsets(q, t), gait_offsets(p, t), atol=1e-3)
+        assert torch.allclose(reverse_gait(q), p, atol=1e-6)
+        assert q.min() >= -1 and q.max() <= 1
+    forward = make_gait_policy("allegro/rotate_y-")
+    backward = make_gait_policy("allegro/rotate_y-,reverse=1")
+    assert forward.gait_row["mode"] == "rotate_y-"
+    assert backward.gait_row["mode"] == "rotate_y+" and backward.gait_row["reversed_from"] == "rotate_y-"
+    u = _stand_in_env(1, "rotate_y+", [0.0, 1.0, 0.0])
+    u.elapsed_steps[:] = 0
+    a_f, a_b = forward(None, u), backward(None, u)  # from the start command, the first step of each loop
+    p = best_gait(resolve_gait("allegro/rotate_y-"))[0]
+    want_b = gait_offsets(p, torch.tensor(-1.0)) / 0.1  # the first target: the forward gait's at t = -1
+    assert torch.allclose(a_b[0, 6:], want_b.clamp(-1, 1), atol=1e-5) and not torch.allclose(a_f, a_b)
+    with pytest.raises(ValueError, match="reverse must be 0 or 1"):
+        make_gait_policy("allegro/rotate_y-,reverse=2")

@@ -52,6 +52,20 @@ def gait_offsets(p, t, dtype=torch.float32) -> torch.Tensor:
     return off.float()
 
 
+def reverse_gait(p) -> torch.Tensor:
+    """The gait ``p`` run backwards in time: its offsets at step t are ``p``'s at -t (same period,
+    amplitudes and bias; phase 1 - phase, loop phase -loop, wrapped into [-1, 1]). A finger loop
+    traversed the other way round turns a held object the other way, as far as the motion is
+    kinematic (slow, friction holding), so a gait for one direction of an axis is a candidate
+    for the opposite direction."""
+    q = torch.as_tensor(p, dtype=torch.float64).clone()
+    for f in range(4):
+        ph, loop = float(q[6 * f + 3]), float(q[6 * f + 4])
+        q[6 * f + 3] = (1.0 - ph + 1.0) % 2.0 - 1.0
+        q[6 * f + 4] = (-loop + 1.0) % 2.0 - 1.0
+    return q.to(torch.as_tensor(p).dtype if torch.is_tensor(p) else torch.float32)
+
+
 def gait_targets(p, t: int, q0: torch.Tensor) -> torch.Tensor:
     """Finger targets [..., 16] of gait ``p`` at control step ``t`` around ``q0`` [..., 16] (the
     offsets in float64, as the searches that found the shipped gaits computed them)."""
@@ -61,12 +75,13 @@ def gait_targets(p, t: int, q0: torch.Tensor) -> torch.Tensor:
 SHIPPED_DIR = Path(__file__).resolve().parent / "checkpoints"
 
 
-GAIT_OPTIONS = {"tracking": str, "lookahead": float, "grid": int}
+GAIT_OPTIONS = {"tracking": str, "lookahead": float, "grid": int, "reverse": int}
 
 
 def split_gait_spec(spec: str) -> Tuple[str, dict]:
     """(gait, options) of ``GAIT[,key=value...]``, the options of :func:`make_gait_policy`
-    (``tracking``, ``lookahead``, ``grid``), e.g. ``allegro/rotate_y-,tracking=phase,lookahead=1.5``."""
+    (``tracking``, ``lookahead``, ``grid``, ``reverse``), e.g. ``allegro/rotate_y-,tracking=phase,lookahead=1.5``
+    or ``allegro/rotate_y-,reverse=1`` (the y- gait run backwards, :func:`reverse_gait`)."""
     base, *rest = spec.split(",")
     opts = {}
     for kv in rest:
@@ -140,7 +155,7 @@ def gait_mode(row: dict) -> str:
 TRACKING = ("clock", "phase")
 
 
-def make_gait_policy(spec: str, tracking: str = "clock", lookahead: float = 1.0, grid: int = 8):
+def make_gait_policy(spec: str, tracking: str = "clock", lookahead: float = 1.0, grid: int = 8, reverse: int = 0):
     """The scripted in-hand policy of the best gait in ``spec`` (a log, or a shipped gait's
     ``<hand>/<mode>``; see the module docstring). Options written into ``spec`` after commas
     (``allegro/rotate_y-,tracking=phase,lookahead=1.5``; :func:`split_gait_spec`) override the
@@ -156,14 +171,24 @@ def make_gait_policy(spec: str, tracking: str = "clock", lookahead: float = 1.0,
       autonomous limit cycle, whose action depends on the command and the start command q0 only,
       not on a clock. Labels of this kind are a function of what a policy can observe (up to q0,
       fixed per episode), so a network can fit them on states it has not seen.
+
+    ``reverse=1``: the gait run backwards in time (:func:`reverse_gait`); the stop still follows
+    the env's own axis, so ``allegro/rotate_y-,reverse=1`` on a y+ env stops at a y+ success.
     """
     spec, opts = split_gait_spec(spec)
     tracking, lookahead, grid = opts.get("tracking", tracking), opts.get("lookahead", lookahead), opts.get("grid", grid)
+    reverse = opts.get("reverse", reverse)
     if tracking not in TRACKING:
         raise ValueError(f"gait tracking must be one of {TRACKING}, got {tracking!r}")
     if grid < 1:
         raise ValueError(f"gait grid must be >= 1, got {grid}")
+    if reverse not in (0, 1):
+        raise ValueError(f"gait reverse must be 0 or 1, got {reverse}")
     p, row = best_gait(resolve_gait(spec))
+    if reverse:  # a gait for the opposite direction of the same axis
+        p = reverse_gait(p)
+        mode = gait_mode(row)
+        row = dict(row, mode=mode[:-1] + {"+": "-", "-": "+"}[mode[-1]], reversed_from=mode, p=p.tolist())
     period = gait_period(p)
     taus = torch.arange(int(math.ceil(period * grid))) / grid
     cycle = gait_offsets(p, taus[taus < period])  # [K, 16] offsets over one period
