@@ -44,6 +44,14 @@ that ``unicross eval --policy gait:LOG`` runs (:mod:`unicross.gaits`). The shipp
         --steps 400 --amplitude 0.6 --no-randomize --limit 2 --generations 8 --sigma 0.2 --select 6 \
         --out docs/runs/gait_search/rotate_x+_hold.jsonl
 
+``--init-reversed`` starts from the logged gaits run backwards in time (their rotations negated):
+the y- gaits, reversed, gave y+ the gait it ships (section "Scripted rotation gaits" of the README):
+
+    python benchmarks/gait_search.py --skill rotate --axis y+ --refine y+ --hold --init-reversed \
+        --init docs/runs/gait_search/rotate_y-_hold.jsonl.gz docs/runs/gait_search/rotate_y-_hold2.jsonl.gz \
+        --steps 400 --amplitude 0.6 --no-randomize --limit 4 --generations 6 --sigma 0.15 --select 6 \
+        --out docs/runs/gait_search/rotate_y+_reversed.jsonl
+
 Episodes run in two spawned worker processes, one env per object each.
 """
 from __future__ import annotations
@@ -133,11 +141,14 @@ def evaluate(pool, gaits, args, n_obj, first: int = 0, hold=None, seeds=None):
     return np.array(pool.map(episode, jobs, chunksize=1)).reshape(len(gaits), n_obj * len(seeds), 9)
 
 
-def init_gaits(paths, amplitude: float):
+def init_gaits(paths, amplitude: float, reverse: bool = False):
     """(gaits [n, 25] as this search's parameters, their logged results [n, episodes, 8]) of the rows of
     earlier logs: a one-finger row gets its still fingers' amplitudes zeroed, and every row is rescaled
-    from its log's ``--amplitude`` to ``amplitude`` (clipped to [-1, 1]), so it moves the fingers as logged."""
-    from unicross.gaits import read_log
+    from its log's ``--amplitude`` to ``amplitude`` (clipped to [-1, 1]), so it moves the fingers as logged.
+    ``reverse``: each gait run backwards in time (:func:`unicross.gaits.reverse_gait`) and its logged
+    rotation and displacement negated (what a kinematic motion run backwards would do; the first
+    generation tests it)."""
+    from unicross.gaits import read_log, reverse_gait
     ps, rs = [], []
     for path in paths:
         for row in read_log(path):
@@ -148,8 +159,12 @@ def init_gaits(paths, amplitude: float):
                     if f != finger:
                         p[6 * f: 6 * f + 3] = 0.0
             p[:24] = (p[:24] * row.get("meta", {}).get("amplitude", 1.0) / amplitude).clip(-1, 1)
+            r = np.array(row["r"])[:, :8]
+            if reverse:
+                p = reverse_gait(p).double().numpy()
+                r[:, :6] = -r[:, :6]
             ps.append(p)
-            rs.append(np.array(row["r"])[:, :8])
+            rs.append(r)
     n_ep = min(r.shape[0] for r in rs)
     return np.array(ps), np.array([r[:n_ep] for r in rs])
 
@@ -190,6 +205,8 @@ def main():
     ap.add_argument("--init", nargs="+", default=None,
                     help="--refine: start from the best gait of these logs (same score); with --hold the first "
                          "generation is the 16 logged gaits that moved the object furthest")
+    ap.add_argument("--init-reversed", action="store_true",
+                    help="--init: the logged gaits run backwards in time (a gait for y- as a start for y+)")
     ap.add_argument("--refine", default=None, help="cross-entropy search for motion along / about this axis (x+ ... z-)")
     ap.add_argument("--generations", type=int, default=10)
     ap.add_argument("--sigma", type=float, default=0.35, help="--refine: the search's starting spread")
@@ -248,13 +265,13 @@ def main():
         mu, sig, pop = np.zeros(NPAR), np.full(NPAR, args.sigma), 16
         first = None
         if args.init and hold:  # the first generation: the logged gaits that moved the object furthest,
-            ps, rs = init_gaits(args.init, args.amplitude)  # drops ignored (holding might have prevented them)
+            ps, rs = init_gaits(args.init, args.amplitude, args.init_reversed)  # drops ignored (holding might have prevented them)
             reach = (sign * rs[:, :, col] / unit).clip(-1, 1).mean(1)
             first = ps[np.argsort(-reach)[:pop]]
             print(f"first generation: the {pop} gaits of {len(ps)} in {args.init} that moved the object furthest "
                   f"(mean reach {np.sort(reach)[-pop:].mean():.2f} success units)", flush=True)
         elif args.init:
-            ps, rs = init_gaits(args.init, args.amplitude)
+            ps, rs = init_gaits(args.init, args.amplitude, args.init_reversed)
             s0 = scores(rs)
             mu = ps[int(np.argmax(s0))]
             print(f"starting from the best gait of {args.init} (score {s0.max():.3f})", flush=True)
