@@ -147,7 +147,9 @@ def init_gaits(paths, amplitude: float, reverse: bool = False):
     from its log's ``--amplitude`` to ``amplitude`` (clipped to [-1, 1]), so it moves the fingers as logged.
     ``reverse``: each gait run backwards in time (:func:`unicross.gaits.reverse_gait`) and its logged
     rotation and displacement negated (what a kinematic motion run backwards would do; the first
-    generation tests it)."""
+    generation tests it). The reversal acts on this search's parameters, which ``--amplitude`` scales
+    phases included, so with an amplitude below 1 the gait runs backwards up to a time shift common
+    to all fingers (the same motion from another start)."""
     from unicross.gaits import read_log, reverse_gait
     ps, rs = [], []
     for path in paths:

@@ -141,7 +141,7 @@ def test_gait_options_ride_in_the_spec(tmp_path):
     assert not torch.equal(phase, make_gait_policy("allegro/rotate_y-")(None, u))
 
 
-def test_a_reversed_gait_runs_the_same_loop_backwards_and_is_a_gait_for_the_opposite_direction():
+def test_a_reversed_gait_runs_the_same_loop_backwards_and_is_a_gait_for_the_opposite_direction(tmp_path):
     """``reverse_gait``: offsets at t are the original's at -t (every finger, distal loop included),
     reversing twice gives the gait back, and ``reverse=1`` names the opposite direction as its mode
     and moves the fingers the other way round on a stand-in env."""
@@ -159,6 +159,8 @@ def test_a_reversed_gait_runs_the_same_loop_backwards_and_is_a_gait_for_the_oppo
     backward = make_gait_policy("allegro/rotate_y-,reverse=1")
     assert forward.gait_row["mode"] == "rotate_y-"
     assert backward.gait_row["mode"] == "rotate_y+" and backward.gait_row["reversed_from"] == "rotate_y-"
+    (tmp_path / "reversed.jsonl").write_text(json.dumps(backward.gait_row) + "\n")  # the row an eval records
+    assert torch.allclose(best_gait(str(tmp_path / "reversed.jsonl"))[0], torch.tensor(backward.gait_row["p"]), atol=1e-6)
     u = _stand_in_env(1, "rotate_y+", [0.0, 1.0, 0.0])
     u.elapsed_steps[:] = 0
     a_f, a_b = forward(None, u), backward(None, u)  # from the start command, the first step of each loop

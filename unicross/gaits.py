@@ -59,11 +59,9 @@ def reverse_gait(p) -> torch.Tensor:
     kinematic (slow, friction holding), so a gait for one direction of an axis is a candidate
     for the opposite direction."""
     q = torch.as_tensor(p, dtype=torch.float64).clone()
-    for f in range(4):
-        ph, loop = float(q[6 * f + 3]), float(q[6 * f + 4])
-        q[6 * f + 3] = (1.0 - ph + 1.0) % 2.0 - 1.0
-        q[6 * f + 4] = (-loop + 1.0) % 2.0 - 1.0
-    return q.to(torch.as_tensor(p).dtype if torch.is_tensor(p) else torch.float32)
+    q[3:24:6] = (1.0 - q[3:24:6] + 1.0) % 2.0 - 1.0  # each finger's phase
+    q[4:24:6] = (-q[4:24:6] + 1.0) % 2.0 - 1.0  # each finger's loop phase
+    return q.to(p.dtype if torch.is_tensor(p) else torch.float32)
 
 
 def gait_targets(p, t: int, q0: torch.Tensor) -> torch.Tensor:
@@ -188,7 +186,8 @@ def make_gait_policy(spec: str, tracking: str = "clock", lookahead: float = 1.0,
     if reverse:  # a gait for the opposite direction of the same axis
         p = reverse_gait(p)
         mode = gait_mode(row)
-        row = dict(row, mode=mode[:-1] + {"+": "-", "-": "+"}[mode[-1]], reversed_from=mode, p=p.tolist())
+        row = dict(row, mode=mode[:-1] + {"+": "-", "-": "+"}[mode[-1]], reversed_from=mode, p=p.tolist(),
+                   meta=dict(row.get("meta", {}), amplitude=1.0))  # p has the log's amplitude applied already
     period = gait_period(p)
     taus = torch.arange(int(math.ceil(period * grid))) / grid
     cycle = gait_offsets(p, taus[taus < period])  # [K, 16] offsets over one period
