@@ -50,7 +50,7 @@ the y- gaits, reversed, gave y+ the gait it ships (section "Scripted rotation ga
     python benchmarks/gait_search.py --skill rotate --axis y+ --refine y+ --hold --init-reversed \
         --init docs/runs/gait_search/rotate_y-_hold.jsonl.gz docs/runs/gait_search/rotate_y-_hold2.jsonl.gz \
         --steps 400 --amplitude 0.6 --no-randomize --limit 4 --generations 6 --sigma 0.15 --select 6 \
-        --out docs/runs/gait_search/rotate_y+_reversed.jsonl
+        --select-seeds 4 --out docs/runs/gait_search/rotate_y+_reversed.jsonl
 
 Episodes run in two spawned worker processes, one env per object each.
 """
