@@ -14,6 +14,11 @@ A second table compares the physics settings that decide speed (hand self-collis
 offset) on a holding scene: bare physics control steps/s for each combination.
 
     python benchmarks/env_throughput.py [--hand allegro] [--steps 300] [--reps 5] [--breakdown] [--json out.json] [--no-settings]
+        [--modes eager torch.compile compiled] [--tasks UniCross-Rotate-v1 ...]
+
+``--modes`` / ``--tasks`` time a subset (e.g. ``--modes compiled`` on a fresh machine, where every
+compiled mode first compiles each task's graph: ~1 min each); a mode left out reports null. Each
+task's row is printed as JSON as soon as it is measured.
 """
 from __future__ import annotations
 
@@ -68,6 +73,9 @@ def _time_env(u, steps, seed=0):
     return rate, targets, joints, float(contacts.item()) / steps
 
 
+# (mode, UNICROSS_COMPILE value)
+MODES = (("eager", "0"), ("torch.compile", "torch"), ("compiled", "1"))
+
 TIMED = ("_command_math", "_apply_command", "_step_action", "_read", "_step_math", "get_info")
 
 
@@ -117,6 +125,9 @@ def main():
     p.add_argument("--breakdown", action="store_true",
                    help="also time the parts of a compiled step inside the loop (us per step)")
     p.add_argument("--no-settings", dest="settings", action="store_false", help="skip the physics-settings table")
+    p.add_argument("--modes", nargs="+", choices=[m for m, _ in MODES], default=[m for m, _ in MODES],
+                   help="step-math modes to time (bare physics is always timed)")
+    p.add_argument("--tasks", nargs="+", choices=[t for t, _ in TASKS], default=[t for t, _ in TASKS])
     args = p.parse_args()
     torch.set_num_threads(1)
     objects = get_object_set("train", limit=1)
@@ -126,9 +137,13 @@ def main():
     print(f"hand {args.hand}: {len(objects)} objects with a scripted grasp")
     rows = []
     for task, kw in TASKS:
+        if task not in args.tasks:
+            continue
         built = {}
         try:
-            for mode, flag in (("eager", "0"), ("torch.compile", "torch"), ("compiled", "1")):
+            for mode, flag in MODES:
+                if mode not in args.modes:
+                    continue
                 os.environ["UNICROSS_COMPILE"] = flag  # read when an env is made
                 env, u = _holding_env(task, kw, gs, objects, hand=args.hand)
                 _time_env(u, 5)  # the compiled env compiles (or loads its graph) here
@@ -146,15 +161,20 @@ def main():
                 u.set_state_dict(state)
                 phys_rates.append(_time_physics(u, commands, joints))
         # medians of the interleaved repetitions (a shared VM's noise: single runs differ by up to ~30%)
-        e, d, c, b = (statistics.median(v) for v in (rates["eager"], rates["torch.compile"], rates["compiled"],
-                                                      phys_rates))
-        rows.append(dict(task=task, eager_steps_per_s=round(e, 1), torch_compile_steps_per_s=round(d, 1),
-                         compiled_steps_per_s=round(c, 1), bare_physics_steps_per_s=round(b, 1),
-                         eager_ratio=round(e / b, 3), torch_compile_ratio=round(d / b, 3),
-                         compiled_ratio=round(c / b, 3), contacts=round(contacts, 1), repetitions=args.reps,
-                         runs={**{m: [round(r, 1) for r in v] for m, v in rates.items()},
-                               "physics": [round(r, 1) for r in phys_rates]}))
-        if args.breakdown:
+        b = statistics.median(phys_rates)
+        med = {m: statistics.median(rates[m]) if m in rates else None for m, _ in MODES}
+        row = dict(task=task)
+        for m, _ in MODES:
+            row[f"{m.replace('.', '_')}_steps_per_s"] = None if med[m] is None else round(med[m], 1)
+        row["bare_physics_steps_per_s"] = round(b, 1)
+        for m, _ in MODES:
+            row[f"{m.replace('.', '_')}_ratio"] = None if med[m] is None else round(med[m] / b, 3)
+        row.update(contacts=round(contacts, 1), repetitions=args.reps,
+                   runs={**{m: [round(r, 1) for r in v] for m, v in rates.items()},
+                         "physics": [round(r, 1) for r in phys_rates]})
+        rows.append(row)
+        print(json.dumps({k: v for k, v in row.items() if k != "runs"}), flush=True)
+        if args.breakdown and "compiled" in built:
             u, state = built["compiled"][1:]
             u.set_state_dict(state)
             rows[-1]["compiled_breakdown_us"] = _breakdown(u, args.steps)
@@ -163,10 +183,12 @@ def main():
             env.close()
     print(f"{'task':28s} {'eager/s':>8s} {'torch.compile/s':>16s} {'compiled/s':>11s} {'physics/s':>10s} "
           f"{'eager ratio':>12s} {'torch.compile ratio':>20s} {'compiled ratio':>15s} {'links in contact':>17s}")
+    def f(v, width, digits):
+        return f"{'--':>{width}s}" if v is None else f"{v:{width}.{digits}f}"
     for r in rows:
-        print(f"{r['task']:28s} {r['eager_steps_per_s']:8.0f} {r['torch_compile_steps_per_s']:16.0f} "
-              f"{r['compiled_steps_per_s']:11.0f} {r['bare_physics_steps_per_s']:10.0f} {r['eager_ratio']:12.2f} "
-              f"{r['torch_compile_ratio']:20.2f} {r['compiled_ratio']:15.2f} {r['contacts']:17.1f}")
+        print(f"{r['task']:28s} {f(r['eager_steps_per_s'], 8, 0)} {f(r['torch_compile_steps_per_s'], 16, 0)} "
+              f"{f(r['compiled_steps_per_s'], 11, 0)} {r['bare_physics_steps_per_s']:10.0f} {f(r['eager_ratio'], 12, 2)} "
+              f"{f(r['torch_compile_ratio'], 20, 2)} {f(r['compiled_ratio'], 15, 2)} {r['contacts']:17.1f}")
     settings = []
     for self_collision, offset in ([(True, 0.02), (True, 0.002), (False, 0.02), (False, 0.002)] if args.settings else []):
         env, u = _holding_env("UniCross-Relocate-v1", {}, gs, objects, hand=args.hand,
