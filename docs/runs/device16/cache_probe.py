@@ -7,7 +7,7 @@ import time
 
 import torch
 
-from torch._dynamo.utils import counters  # noqa: E402
+from torch._dynamo.utils import counters
 
 # unicross/compiling.py alone (it needs torch only), without the package's other imports
 spec = importlib.util.spec_from_file_location("compiling", os.path.join(os.getcwd(), "unicross", "compiling.py"))
