@@ -8,6 +8,9 @@ training W:  ``unicross train``'s loop (lean collector with W worker processes, 
 efficiency:  training W / (W x single env)  (target: >= 0.8 at 2 workers, issue "Training at the
              speed of physics").
 
+``--compare-overlap``: each worker count twice, collection then update (the default) and with
+``collector.overlap`` (the workers collect the next batch during the update), in the same run.
+
 Writes JSON (``--json``) and a PNG curve (``--png``). ``--set section.key=value`` overrides
 ``configs/ppo.yaml`` as ``unicross train --set`` does (e.g. the in-hand experts' 4096-frame batches
 and ``optim.kl_stop``), for the training rows only.
@@ -82,16 +85,25 @@ def main():
     p.add_argument("--iterations", type=int, default=4)
     p.add_argument("--env-steps", type=int, default=1500)
     p.add_argument("--set", action="append", metavar="SECTION.KEY=VALUE", help="override configs/ppo.yaml")
+    p.add_argument("--compare-overlap", action="store_true",
+                   help="each worker count without and with collector.overlap (needs >= 2 workers)")
     p.add_argument("--json", default=None)
     p.add_argument("--png", default=None)
     args = p.parse_args()
+    if args.compare_overlap and min(args.workers) < 2:
+        p.error("--compare-overlap needs >= 2 workers (overlapped collection runs in worker processes)")
+    overrides = parse_sets(args.set)
     single = single_env_rate(args.env_steps)
     rows = []
     for w in args.workers:
-        r = training_rate(w, args.iterations, parse_sets(args.set))
-        r["efficiency"] = round(r["training_fps"] / (w * single), 3)
-        rows.append(r)
-        print(json.dumps(r), flush=True)
+        for overlap in ((False, True) if args.compare_overlap else (None,)):
+            ov = overrides if overlap is None else deep_merge(overrides, {"collector": {"overlap": overlap}},
+                                                             strict=False)
+            r = training_rate(w, args.iterations, ov)
+            r["overlap"] = bool(ov.get("collector", {}).get("overlap", False))
+            r["efficiency"] = round(r["training_fps"] / (w * single), 3)
+            rows.append(r)
+            print(json.dumps(r), flush=True)
     out = dict(single_env_steps_per_s=round(single, 1), cores=os.cpu_count(), settings=args.set or [], rows=rows)
     print(json.dumps(out, indent=1))
     if args.json:
@@ -101,9 +113,12 @@ def main():
         import matplotlib
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
-        ws = [r["workers"] for r in rows]
+        ws = sorted({r["workers"] for r in rows})
         fig, ax = plt.subplots(figsize=(5, 3.5))
-        ax.plot(ws, [r["training_fps"] for r in rows], "o-", label="training (PPO, lean collector)")
+        for overlap in sorted({r["overlap"] for r in rows}):
+            sel = [r for r in rows if r["overlap"] == overlap]
+            ax.plot([r["workers"] for r in sel], [r["training_fps"] for r in sel], "o-",
+                    label="training (PPO, lean collector" + (", overlapped)" if overlap else ")"))
         ax.plot(ws, [w * single for w in ws], "--", color="gray", label="workers x single env")
         ax.set_xticks(ws)
         ax.set_xlabel("env worker processes")

@@ -1,5 +1,7 @@
 """The lean collector: worker processes act with the main process's current weights, store the
 log-probabilities the PPO loss recomputes, and keep episode boundaries as TorchRL's GAE reads them."""
+import copy
+
 import pytest
 import torch
 from torchrl.data import Bounded
@@ -144,6 +146,53 @@ def test_evaluation_in_the_workers_equals_one_process():
         c.close()
     whole = evaluation_shard(policy.module[0].module, shard=None, **kw)
     assert len(whole) == 4 and sorted(split, key=lambda t: t["object"]) == sorted(whole, key=lambda t: t["object"])
+
+
+def test_overlapped_workers_act_with_their_own_copy_until_synced():
+    """collector.overlap: the workers' actor is a copy that follows the learner's only at
+    sync_actor(), so a batch started before an update is the old weights' whatever the update does
+    meanwhile; an evaluation while a batch is in flight keeps that batch and runs the current weights."""
+    from unicross.rl.ppo import evaluation_shard
+    c = LeanCollector("UniCross-Grasp-v1", KW, num_envs=2, horizon=8, seed=3)
+    try:
+        policy, _ = _models(c)
+        actor = policy.module[0].module
+        c.set_actor(actor, own_copy=True)
+        old = copy.deepcopy(policy)
+        c.start()
+        with pytest.raises(RuntimeError, match="pending"):
+            c.start()
+        with pytest.raises(RuntimeError, match="being collected"):
+            c.sync_actor()
+        with torch.no_grad():  # the learner's update, during the batch
+            actor.net.main[-1].bias.add_(0.3)
+        data = c.finish()
+        _check_batch(old, data)
+        _check_batch(old, c.collect())  # not synced: still the old weights
+        c.sync_actor()
+        _check_batch(policy, c.collect())
+        with torch.no_grad():
+            actor.net.main[-1].bias.add_(-0.6)
+        c.start()  # in flight with the weights before that change
+        kw = dict(skill="grasp", objects="test", limit=1, trials_per_object=1, seed=2, hand="allegro", axis=None,
+                  ablation=None)
+        split = [t for part in c.map_shards(evaluation_shard, **kw) for t in part]
+        assert c.pending
+        kept = c.finish()
+        assert kept.shape == (2, 8) and not c.pending
+        with pytest.raises(RuntimeError, match="without start"):
+            c.finish()
+        _check_batch(policy, c.collect())  # the evaluation synced the copy
+    finally:
+        c.close()
+    whole = evaluation_shard(actor, shard=None, **kw)
+    assert sorted(split, key=lambda t: t["object"]) == sorted(whole, key=lambda t: t["object"])
+    with pytest.raises(ValueError, match="worker processes"):
+        one = LeanCollector("UniCross-Grasp-v1", KW, num_envs=1, horizon=4, seed=0)
+        try:
+            one.set_actor(actor, own_copy=True)
+        finally:
+            one.close()
 
 
 @pytest.mark.slow

@@ -47,6 +47,30 @@ def test_tiny_ppo_updates_weights_with_finite_losses(tmp_path):
     t.close()
 
 
+def test_overlapped_collection_trains_and_resumes(tmp_path):
+    """collector.overlap: two env workers collect each batch during the previous update; the run
+    counts the frames it trains on, checkpoints and resumes; one env is refused before simulating."""
+    over = dict(TINY, env=dict(num_envs=2, object_limit=1), collector=dict(total_frames=96, horizon=16, overlap=True))
+    t = PPOTrainer(tmp_path / "run", "grasp", overrides=over, progress=False)
+    try:
+        before = [p.detach().clone() for p in t.policy.parameters()]
+        t.train(max_iterations=2)
+        assert t.frames == 64 and t.collector.pending  # the third batch is on its way
+        assert any(not torch.equal(a, b) for a, b in zip(before, t.policy.parameters()))
+        t.save()
+    finally:
+        t.close()
+    t = PPOTrainer(tmp_path / "run", resume=True, progress=False)
+    try:
+        t.train()
+        assert t.frames == 96 and t.iteration == 3 and not t.collector.pending
+    finally:
+        t.close()
+    with pytest.raises(ValueError, match="collector.overlap needs env worker processes"):
+        PPOTrainer(tmp_path / "one", "grasp", overrides=dict(TINY, collector=dict(total_frames=96, horizon=16,
+                                                                                   overlap=True)), progress=False)
+
+
 def test_training_needs_no_edit_for_another_hand(tmp_path):
     """The same trainer, networks and checkpoint for the 28-DoF Sharpa Wave (in-hand rotate,
     starting from its shipped grasps): sizes follow from the hand description."""

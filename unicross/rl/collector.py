@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import atexit
 import contextlib
+import copy
 import math
 import os
 import signal
@@ -305,6 +306,12 @@ class LeanCollector:
     (``model.base_policy``). The envs are built first (``dims``,
     ``n_act`` come from them); :meth:`set_actor` then hands them the actor, whose tensors are moved
     to shared memory, so the optimiser's in-place steps and the statistics updates reach the workers.
+
+    Overlapped collection (``set_actor(actor, own_copy=True)``, PPO's ``collector.overlap``): the
+    workers act with a copy of the actor in shared memory, refreshed from the learner's only by
+    :meth:`sync_actor`, so that :meth:`start` can launch the next batch while the main process
+    updates the learner's weights (the batch then comes from the weights of one update earlier).
+    :meth:`finish` waits for the batch; :meth:`collect` is the two in a row.
     """
 
     def __init__(self, env_id: str, env_kwargs: dict, num_envs: int, horizon: int, seed: int = 0,
@@ -313,6 +320,10 @@ class LeanCollector:
         self.horizon, self.num_envs, self.teacher = horizon, num_envs, teacher is not None
         kw = dict(env_kwargs)
         self._procs, self._conns, self._local, self.buf = [], [], None, None
+        self._learner: Optional[torch.nn.Module] = None  # the actor the workers' copy follows (own_copy)
+        self._shared: Optional[torch.nn.Module] = None  # the actor in shared memory the workers run
+        self._pending = False  # a batch is being collected (start() without finish())
+        self._stash: Optional[TensorDict] = None  # a finished batch not yet taken (see map_shards)
         if backend == "physx_cuda":
             kw.update(sim_backend="physx_cuda", num_envs=num_envs)
         else:
@@ -337,13 +348,24 @@ class LeanCollector:
     def frames_per_batch(self) -> int:
         return self.num_envs * self.horizon
 
-    def set_actor(self, actor: torch.nn.Module) -> None:
-        """The module ``(hand, object, goal) -> (loc, scale)`` the envs act with."""
+    @property
+    def has_workers(self) -> bool:
+        """Whether the envs run in worker processes (what overlapped collection needs)."""
+        return self._local is None
+
+    def set_actor(self, actor: torch.nn.Module, own_copy: bool = False) -> None:
+        """The module ``(hand, object, goal) -> (loc, scale)`` the envs act with; ``own_copy`` (env
+        workers only): they act with a copy of it that :meth:`sync_actor` refreshes."""
         if self._local is not None:
+            if own_copy:
+                raise ValueError("overlapped collection needs env worker processes (num_envs > 1 on physx_cpu)")
             self._local.set_actor(actor)
             self.buf = make_buffer(self.num_envs, self.horizon, self.dims, self.n_act, self.device, self.teacher)
             return
+        if own_copy:
+            self._learner, actor = actor, copy.deepcopy(actor)
         actor.share_memory()
+        self._shared = actor
         self.buf = make_buffer(self.num_envs, self.horizon, self.dims, self.n_act, teacher=self.teacher).share_memory_()
         for conn in self._conns:
             conn.send(("setup", (actor, self.buf)))
@@ -366,18 +388,54 @@ class LeanCollector:
             raise RuntimeError("\n".join(errors))
         return payloads
 
-    def collect(self) -> TensorDict:
-        """One batch ``[num_envs, horizon]`` (a copy: the caller may add keys and rescale)."""
+    @torch.no_grad()
+    def sync_actor(self) -> None:
+        """The workers' copy of the actor takes the learner's current weights and statistics
+        (``set_actor(..., own_copy=True)``; no-op otherwise). Only between batches."""
+        if self._pending:
+            raise RuntimeError("sync_actor() while a batch is being collected")
+        if self._learner is not None:
+            self._shared.load_state_dict(self._learner.state_dict())  # in place: stays in shared memory
+
+    @property
+    def pending(self) -> bool:
+        """A batch started and not yet taken by :meth:`finish`."""
+        return self._pending or self._stash is not None
+
+    def start(self) -> None:
+        """Launches the next batch in the workers and returns at once (in-process envs: the batch
+        is collected by :meth:`finish`)."""
         if self.buf is None:
             raise RuntimeError("set_actor() first")
-        if self._local is not None:
-            with one_thread():
-                self._local.collect(self.buf)
-        else:
+        if self.pending:
+            raise RuntimeError("start() while a batch is pending: finish() it first")
+        if self._local is None:
             for conn in self._conns:
                 conn.send("collect")
-            self._wait("done")
+        self._pending = True
+
+    def finish(self) -> TensorDict:
+        """The batch of the last :meth:`start`, ``[num_envs, horizon]`` (a copy: the caller may add
+        keys and rescale), once the workers are done with it."""
+        if self._stash is not None:
+            data, self._stash = self._stash, None
+            return data
+        if not self._pending:
+            raise RuntimeError("finish() without start()")
+        try:
+            if self._local is not None:
+                with one_thread():
+                    self._local.collect(self.buf)
+            else:
+                self._wait("done")
+        finally:
+            self._pending = False
         return self.buf.clone()
+
+    def collect(self) -> TensorDict:
+        """One batch ``[num_envs, horizon]`` (a copy: the caller may add keys and rescale)."""
+        self.start()
+        return self.finish()
 
     def map_shards(self, fn, **kwargs) -> list:
         """``fn(actor, shard=(i, n), **kwargs)`` in each of the n workers (their envs idle), e.g. an
@@ -386,6 +444,9 @@ class LeanCollector:
         if self._local is not None:
             with one_thread():
                 return [fn(self._local.actor, shard=None, **kwargs)]
+        if self._pending:  # a batch in flight: kept for the next finish()
+            self._stash = self.finish()
+        self.sync_actor()  # the workers evaluate the learner's current weights
         n = len(self._conns)
         for rank, conn in enumerate(self._conns):
             conn.send(("call", fn, dict(kwargs, shard=(rank, n))))

@@ -149,6 +149,11 @@ class PPOTrainer(Runner):
             raise ValueError("loss.teacher_coef > 0 needs collector.teacher (e.g. allegro/rotate_y-)")
         self.share_cores(ec["backend"])
         num_envs = resolve_num_envs(ec["num_envs"], ec["backend"], cfg["collector"].get("ray_address"))
+        self.overlap = bool(cfg["collector"].get("overlap", False))
+        if self.overlap and (ec["backend"] != "physx_cpu" or num_envs < 2 or cfg["collector"].get("ray_address")):
+            raise ValueError(f"collector.overlap needs env worker processes on this machine (env.backend physx_cpu, "
+                             f"num_envs > 1, no collector.ray_address); this run has {ec['backend']}, {num_envs} "
+                             f"env(s), ray_address {cfg['collector'].get('ray_address')}")
         self.horizon = resolve_horizon(cfg["collector"], skill, num_envs)
         # envs of a resumed run start from new seeds (not a replay of the first iteration's starts)
         seed = cfg["seed"] + 1000 * int((self.ckpt or {}).get("iteration", 0))
@@ -179,7 +184,11 @@ class PPOTrainer(Runner):
                 if before[sec].get(key) != cfg[sec].get(key):
                     print(f"[unicross] resumed with {path}={cfg[sec].get(key)} (was {before[sec].get(key)}): "
                           f"{num_envs} envs x {self.horizon} steps = {num_envs * self.horizon} frames per iteration")
-        self.collector.set_actor(self.algo.actor)  # after loading: the workers share these weights
+        # after loading: the workers share these weights (overlap: a copy of them, synced per batch)
+        if self.overlap:
+            self.collector.set_actor(self.algo.actor, own_copy=True)
+        else:
+            self.collector.set_actor(self.algo.actor)
         self._ep_return = torch.zeros(num_envs, 1, device=self.device)
 
     # ------------------------------------------------------------------ state
@@ -301,7 +310,7 @@ class PPOTrainer(Runner):
         t_last = time.perf_counter()
         done_iters = 0
         while self.frames < total:
-            data = self.collector.collect()
+            data = self._next_batch(total)
             t_collect = time.perf_counter() - t_last
             self.iteration += 1
             self.frames += data.numel()
@@ -309,7 +318,7 @@ class PPOTrainer(Runner):
             reward_raw = float(data["next", "reward"].mean())
             ep["nonfinite"] = int(data["next", "info", "nonfinite"].sum())
             t0 = time.perf_counter()
-            self.take_update_threads()
+            self.take_update_threads(busy_cores=self.collector.num_envs if self.overlap and self.collector.pending else 0)
             up = self.algo.update(data)
             t_update = time.perf_counter() - t0
             bad = sorted(k for k, v in up.items() if isinstance(v, float) and not math.isfinite(v))
@@ -334,6 +343,20 @@ class PPOTrainer(Runner):
             t_last = time.perf_counter()
             if (max_iterations is not None and done_iters >= max_iterations) or self.stop_signal is not None:
                 break
+
+    def _next_batch(self, total: int) -> TensorDict:
+        """The iteration's batch. With ``collector.overlap`` the workers already collected it (or are
+        finishing it) during the previous update, with the weights from before that update; they are
+        given the current weights and start the next batch before this one's update."""
+        if not self.overlap:
+            return self.collector.collect()
+        if not self.collector.pending:
+            self.collector.start()
+        data = self.collector.finish()
+        self.collector.sync_actor()
+        if self.frames + data.numel() < total:
+            self.collector.start()
+        return data
 
     def final_evaluation(self) -> dict:
         """The held-out evaluation of the finished expert: the paper's protocol for its skill on

@@ -176,11 +176,13 @@ class Runner:
         if self._cpu_update:
             register_run()
 
-    def take_update_threads(self) -> None:
+    def take_update_threads(self, busy_cores: int = 0) -> None:
         """Before the main process's work of an iteration: torch threads = its share of the cores
-        (:func:`unicross.rl.collector.update_threads`)."""
+        (:func:`unicross.rl.collector.update_threads`), less ``busy_cores`` (env workers collecting
+        during the update, ``collector.overlap``) when the share is automatic; at least 1."""
         if self._cpu_update:
-            torch.set_num_threads(update_threads(self.cfg["optim"].get("update_threads")))
+            value = self.cfg["optim"].get("update_threads")
+            torch.set_num_threads(max(1, update_threads(value) - (busy_cores if value is None else 0)))
 
     # ------------------------------------------------------------------ checkpoint
     def state(self) -> dict:
