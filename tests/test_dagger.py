@@ -101,6 +101,29 @@ def test_dagger_resume(tmp_path, experts):
     r.close()
 
 
+def test_dagger_with_overlapped_rollouts_fills_and_resumes(tmp_path, experts):
+    """collector.overlap: two workers roll out the next epoch during the update; every epoch adds
+    its rollout to the buffer, the last starts none, and a resumed run goes on."""
+    cfg = dict(env=dict(num_envs=2, object_limit=1, reconfiguration_freq=0, randomize=False,
+                        task_config=dict(episode_length=SHORT)),
+               collector=dict(rollout_steps=4, overlap=True), optim=dict(batch_size=8, grad_steps=2, epochs=2),
+               buffer=dict(capacity=100), logging=dict(checkpoint_every=1))
+    t = DAggerTrainer(tmp_path / "run", experts, overrides=cfg, progress=False)
+    try:
+        t.train()
+        assert t.epoch == 2 and len(t.rb) == 16 and t.frames == 16 and not t.collector.pending
+    finally:
+        t.close()
+    r = DAggerTrainer(tmp_path / "run", resume=True, progress=False)
+    try:
+        r.train(epochs=1)
+        assert r.epoch == 3 and len(r.rb) == 24
+    finally:
+        r.close()
+    with pytest.raises(ValueError, match="collector.overlap needs env worker processes"):
+        DAggerTrainer(tmp_path / "one", experts, overrides=dict(cfg, env=dict(cfg["env"], num_envs=1)), progress=False)
+
+
 @pytest.mark.slow
 def test_dagger_on_ray_env_actors_fills_the_buffer_local_workers_fill(tmp_path, experts):
     """DAgger with collector.ray_address (a loopback Ray cluster) labels the same states as with

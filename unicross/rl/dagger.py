@@ -122,9 +122,14 @@ class DAggerTrainer(Runner):
         # or in Ray env actors (collector.ray_address)
         ray_address = cfg["collector"].get("ray_address")
         seed = cfg["seed"] + 1000 * int((self.ckpt or {}).get("epoch", 0))
-        self.collector = make_collector("UniCross-MultiSkill-v1", kw, resolve_num_envs(ec["num_envs"], ec["backend"], ray_address),
-                                        cfg["collector"]["rollout_steps"], seed, ec["backend"], ray_address,
-                                        deterministic=True)
+        num_envs = resolve_num_envs(ec["num_envs"], ec["backend"], ray_address)
+        self.overlap = bool(cfg["collector"].get("overlap", False))
+        if self.overlap and (ec["backend"] != "physx_cpu" or num_envs < 2 or ray_address):
+            raise ValueError(f"collector.overlap needs env worker processes on this machine (env.backend physx_cpu, "
+                             f"num_envs > 1, no collector.ray_address); this run has {ec['backend']}, {num_envs} "
+                             f"env(s), ray_address {ray_address}")
+        self.collector = make_collector("UniCross-MultiSkill-v1", kw, num_envs, cfg["collector"]["rollout_steps"], seed,
+                                        ec["backend"], ray_address, deterministic=True)
         self.dims, self.n_act = self.collector.dims, self.collector.n_act
         self.student, _, self.norm = make_models(self.dims, self.n_act, Bounded(-1.0, 1.0, (self.n_act,)),
                                                  cfg["model"])
@@ -136,7 +141,11 @@ class DAggerTrainer(Runner):
         self.epoch, self.frames = 0, 0
         if self.ckpt is not None:
             self._load(self.ckpt)
-        self.collector.set_actor(self.actor.module)  # after loading: the workers share these weights
+        # after loading: the workers share these weights (overlap: a copy of them, synced per epoch)
+        if self.overlap:
+            self.collector.set_actor(self.actor.module, own_copy=True)
+        else:
+            self.collector.set_actor(self.actor.module)
 
     # ------------------------------------------------------------------ state
     def state(self) -> dict:
@@ -174,10 +183,22 @@ class DAggerTrainer(Runner):
 
     # ------------------------------------------------------------------ one epoch
     @torch.no_grad()
-    def collect(self) -> dict:
+    def collect(self, more: bool = False) -> dict:
         """Roll the student out for ``rollout_steps`` (deterministic actions); label every visited
-        state by its mode's expert; store (observation, expert action, mode)."""
-        flat = self.collector.collect().reshape(-1)
+        state by its mode's expert; store (observation, expert action, mode). With
+        ``collector.overlap`` the rollout was made during the previous epoch's update, with the
+        student of the epoch before (DAgger's labels do not depend on who acted); the workers then
+        take the current student and, if ``more`` epochs follow, start the next rollout."""
+        if self.overlap:
+            if not self.collector.pending:
+                self.collector.start()
+            data = self.collector.finish()
+            self.collector.sync_actor()
+            if more:
+                self.collector.start()
+        else:
+            data = self.collector.collect()
+        flat = data.reshape(-1)
         labels = self.teachers(flat)
         item = flat.select(*OBS_KEYS).clone()
         item["expert_action"] = labels
@@ -244,8 +265,9 @@ class DAggerTrainer(Runner):
         last = {}
         while self.epoch < target and self.stop_signal is None:
             t0 = time.perf_counter()
-            self.take_update_threads()
-            col = self.collect()
+            more = self.epoch + 1 < target
+            self.take_update_threads(busy_cores=self.collector.num_envs if self.overlap and more else 0)
+            col = self.collect(more=more)
             upd = self.update()
             self.epoch += 1
             last = dict(epoch=self.epoch, frames=self.frames, wall_s=self._wall(), buffer=len(self.rb),
