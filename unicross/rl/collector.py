@@ -348,11 +348,6 @@ class LeanCollector:
     def frames_per_batch(self) -> int:
         return self.num_envs * self.horizon
 
-    @property
-    def has_workers(self) -> bool:
-        """Whether the envs run in worker processes (what overlapped collection needs)."""
-        return self._local is None
-
     def set_actor(self, actor: torch.nn.Module, own_copy: bool = False) -> None:
         """The module ``(hand, object, goal) -> (loc, scale)`` the envs act with; ``own_copy`` (env
         workers only): they act with a copy of it that :meth:`sync_actor` refreshes."""
@@ -437,6 +432,18 @@ class LeanCollector:
         self.start()
         return self.finish()
 
+    def next_overlapped(self, more: bool) -> TensorDict:
+        """Overlapped collection's batch: the one started earlier (started now if none), then the
+        workers take the learner's current weights and, if ``more`` batches follow, start the next
+        one, which they collect while the caller updates on this one."""
+        if not self.pending:
+            self.start()
+        data = self.finish()
+        self.sync_actor()
+        if more:
+            self.start()
+        return data
+
     def map_shards(self, fn, **kwargs) -> list:
         """``fn(actor, shard=(i, n), **kwargs)`` in each of the n workers (their envs idle), e.g. an
         evaluation split over objects; returns the n results. One env in the main process: one call
@@ -487,6 +494,15 @@ def resolve_num_envs(num_envs, backend: str, ray_address: Optional[str] = None) 
     if int(num_envs) < 1:
         raise ValueError(f"env.num_envs must be >= 1, got {num_envs}")
     return int(num_envs)
+
+
+def check_overlap(overlap: bool, backend: str, num_envs: int, ray_address: Optional[str]) -> None:
+    """``collector.overlap`` needs env worker processes on this machine: refused (before any
+    simulation) with one env, the GPU backend or Ray env actors."""
+    if overlap and (backend != "physx_cpu" or num_envs < 2 or ray_address):
+        raise ValueError(f"collector.overlap needs env worker processes on this machine (env.backend physx_cpu, "
+                         f"num_envs > 1, no collector.ray_address); this run has {backend}, {num_envs} env(s), "
+                         f"ray_address {ray_address}")
 
 
 def make_collector(env_id: str, env_kwargs: dict, num_envs: int, horizon: int, seed: int, backend: str,

@@ -28,7 +28,7 @@ from tqdm import tqdm
 
 from unicross import formulation as F
 from unicross import registry as R
-from unicross.rl.collector import make_collector, resolve_num_envs
+from unicross.rl.collector import check_overlap, make_collector, resolve_num_envs
 from unicross.rl.models import OBS_KEYS, make_models
 from unicross.rl.policy_io import base_policy_of, load_policy
 from unicross.rl.runner import CKPT_NAME, Runner, atomic_save
@@ -124,10 +124,7 @@ class DAggerTrainer(Runner):
         seed = cfg["seed"] + 1000 * int((self.ckpt or {}).get("epoch", 0))
         num_envs = resolve_num_envs(ec["num_envs"], ec["backend"], ray_address)
         self.overlap = bool(cfg["collector"].get("overlap", False))
-        if self.overlap and (ec["backend"] != "physx_cpu" or num_envs < 2 or ray_address):
-            raise ValueError(f"collector.overlap needs env worker processes on this machine (env.backend physx_cpu, "
-                             f"num_envs > 1, no collector.ray_address); this run has {ec['backend']}, {num_envs} "
-                             f"env(s), ray_address {ray_address}")
+        check_overlap(self.overlap, ec["backend"], num_envs, ray_address)
         self.collector = make_collector("UniCross-MultiSkill-v1", kw, num_envs, cfg["collector"]["rollout_steps"], seed,
                                         ec["backend"], ray_address, deterministic=True)
         self.dims, self.n_act = self.collector.dims, self.collector.n_act
@@ -142,10 +139,7 @@ class DAggerTrainer(Runner):
         if self.ckpt is not None:
             self._load(self.ckpt)
         # after loading: the workers share these weights (overlap: a copy of them, synced per epoch)
-        if self.overlap:
-            self.collector.set_actor(self.actor.module, own_copy=True)
-        else:
-            self.collector.set_actor(self.actor.module)
+        self.collector.set_actor(self.actor.module, own_copy=self.overlap)
 
     # ------------------------------------------------------------------ state
     def state(self) -> dict:
@@ -189,15 +183,7 @@ class DAggerTrainer(Runner):
         ``collector.overlap`` the rollout was made during the previous epoch's update, with the
         student of the epoch before (DAgger's labels do not depend on who acted); the workers then
         take the current student and, if ``more`` epochs follow, start the next rollout."""
-        if self.overlap:
-            if not self.collector.pending:
-                self.collector.start()
-            data = self.collector.finish()
-            self.collector.sync_actor()
-            if more:
-                self.collector.start()
-        else:
-            data = self.collector.collect()
+        data = self.collector.next_overlapped(more) if self.overlap else self.collector.collect()
         flat = data.reshape(-1)
         labels = self.teachers(flat)
         item = flat.select(*OBS_KEYS).clone()

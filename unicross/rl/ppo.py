@@ -25,7 +25,7 @@ from unicross import formulation as F
 from unicross import registry as R
 from unicross.rewards import term_names
 from unicross.rl.algorithm import PPO
-from unicross.rl.collector import check_teacher, make_collector, resolve_num_envs
+from unicross.rl.collector import check_overlap, check_teacher, make_collector, resolve_num_envs
 from unicross.rl.models import OBS_KEYS  # noqa: F401  (re-exported for benchmarks)
 from unicross.rl.runner import CKPT_NAME, Runner, atomic_save, git_commit, open_run  # noqa: F401  (re-exported)
 
@@ -150,10 +150,7 @@ class PPOTrainer(Runner):
         self.share_cores(ec["backend"])
         num_envs = resolve_num_envs(ec["num_envs"], ec["backend"], cfg["collector"].get("ray_address"))
         self.overlap = bool(cfg["collector"].get("overlap", False))
-        if self.overlap and (ec["backend"] != "physx_cpu" or num_envs < 2 or cfg["collector"].get("ray_address")):
-            raise ValueError(f"collector.overlap needs env worker processes on this machine (env.backend physx_cpu, "
-                             f"num_envs > 1, no collector.ray_address); this run has {ec['backend']}, {num_envs} "
-                             f"env(s), ray_address {cfg['collector'].get('ray_address')}")
+        check_overlap(self.overlap, ec["backend"], num_envs, cfg["collector"].get("ray_address"))
         self.horizon = resolve_horizon(cfg["collector"], skill, num_envs)
         # envs of a resumed run start from new seeds (not a replay of the first iteration's starts)
         seed = cfg["seed"] + 1000 * int((self.ckpt or {}).get("iteration", 0))
@@ -185,10 +182,7 @@ class PPOTrainer(Runner):
                     print(f"[unicross] resumed with {path}={cfg[sec].get(key)} (was {before[sec].get(key)}): "
                           f"{num_envs} envs x {self.horizon} steps = {num_envs * self.horizon} frames per iteration")
         # after loading: the workers share these weights (overlap: a copy of them, synced per batch)
-        if self.overlap:
-            self.collector.set_actor(self.algo.actor, own_copy=True)
-        else:
-            self.collector.set_actor(self.algo.actor)
+        self.collector.set_actor(self.algo.actor, own_copy=self.overlap)
         self._ep_return = torch.zeros(num_envs, 1, device=self.device)
 
     # ------------------------------------------------------------------ state
@@ -310,7 +304,10 @@ class PPOTrainer(Runner):
         t_last = time.perf_counter()
         done_iters = 0
         while self.frames < total:
-            data = self._next_batch(total)
+            if self.overlap:  # collected during the previous update, with the weights from before it
+                data = self.collector.next_overlapped(more=self.frames + self.collector.frames_per_batch < total)
+            else:
+                data = self.collector.collect()
             t_collect = time.perf_counter() - t_last
             self.iteration += 1
             self.frames += data.numel()
@@ -343,20 +340,6 @@ class PPOTrainer(Runner):
             t_last = time.perf_counter()
             if (max_iterations is not None and done_iters >= max_iterations) or self.stop_signal is not None:
                 break
-
-    def _next_batch(self, total: int) -> TensorDict:
-        """The iteration's batch. With ``collector.overlap`` the workers already collected it (or are
-        finishing it) during the previous update, with the weights from before that update; they are
-        given the current weights and start the next batch before this one's update."""
-        if not self.overlap:
-            return self.collector.collect()
-        if not self.collector.pending:
-            self.collector.start()
-        data = self.collector.finish()
-        self.collector.sync_actor()
-        if self.frames + data.numel() < total:
-            self.collector.start()
-        return data
 
     def final_evaluation(self) -> dict:
         """The held-out evaluation of the finished expert: the paper's protocol for its skill on

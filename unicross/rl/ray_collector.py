@@ -90,9 +90,12 @@ class RayCollector:
     def frames_per_batch(self) -> int:
         return self.num_envs * self.horizon
 
-    def set_actor(self, actor: torch.nn.Module) -> None:
+    def set_actor(self, actor: torch.nn.Module, own_copy: bool = False) -> None:
         """The module ``(hand, object, goal) -> (loc, scale)`` the envs act with; its current
-        weights go to the env actors at every :meth:`collect`."""
+        weights go to the env actors at every :meth:`collect` (``own_copy``, overlapped collection:
+        not on Ray)."""
+        if own_copy:
+            raise ValueError("overlapped collection (collector.overlap) runs in local env workers, not on Ray")
         self.actor = actor
         self._ray.get([a.set_actor.remote(actor) for a in self._actors])
         self.buf = make_buffer(self.num_envs, self.horizon, self.dims, self.n_act)
