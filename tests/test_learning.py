@@ -172,6 +172,37 @@ def test_untrained_policy_acts_near_zero_and_normaliser_skips_nonfinite_rows():
     assert torch.allclose(out["state_value"], value.value_norm(out["state_value_norm"]))
 
 
+def test_the_rollout_acting_path_equals_the_actor_and_reads_the_weights_live():
+    """``GaussianHead.acting_fn`` (what rollouts act with) gives the actor's (loc, scale) to rounding, with
+    clipped features and a std floor; it follows in-place weight updates (shared-memory workers) and
+    keeps the statistics it was taken with until a fresh one is taken."""
+    from unicross.config import load_config
+    from unicross.rl.models import make_models
+    cfg = load_config("ppo")["model"]
+    cfg["obs_std_min"] = 0.05
+    dims = dict(hand=44, object=105, goal=55)
+    policy, _, norm = make_models(dims, 22, None, cfg)
+    head = policy.module[0].module
+    g = torch.Generator().manual_seed(0)
+    norm.update({k: torch.randn(300, d, generator=g) * 2 + 1 for k, d in dims.items()})
+    with torch.no_grad():
+        for p in head.parameters():
+            p.copy_(torch.randn(p.shape, generator=g) / p.shape[-1] ** 0.5)
+    x = [torch.randn(7, d, generator=g) * 6 for d in dims.values()]  # some features beyond the clip
+    act = head.acting_fn()
+    for a, b in zip(act(*x), head(*x)):
+        assert torch.allclose(a, b, rtol=1e-5, atol=1e-5)  # a strided view may take another GEMM path
+    with torch.no_grad():
+        head.net.main[0].weight.mul_(2.0)  # an update in place
+        norm.update({k: torch.randn(300, d, generator=g) * 5 for k, d in dims.items()})
+    moved = act(*x)[0]
+    assert not torch.allclose(moved, head(*x)[0], rtol=1e-3)  # the statistics were snapshotted
+    assert torch.allclose(head.acting_fn()(*x)[0], head(*x)[0], rtol=1e-5, atol=1e-5)
+    with torch.no_grad():
+        head.net.main[0].weight.mul_(0.5)
+    assert not torch.allclose(act(*x)[0], moved, rtol=1e-3)  # the weights are read live
+
+
 def test_obs_std_floor_keeps_a_barely_varying_feature_off_the_clip_and_travels_with_the_checkpoint(tmp_path):
     """A feature that stayed still in the fitted data (std ~1e-4) reaches the clip at a 1 cm change
     without ``model.obs_std_min``; with a floor of 1e-2 it reads ~1, the rest unchanged; a saved

@@ -91,7 +91,9 @@ def check_teacher(spec: Optional[str], skill: str, axis: Optional[str], backend:
 
 class Rollout:
     """One (batched) UniCross task stepped by an actor (a module ``(hand, object, goal) -> (loc,
-    scale)`` of a diagonal Gaussian, set with :meth:`set_actor`). Episodes run on across
+    scale)`` of a diagonal Gaussian, set with :meth:`set_actor`; where it offers ``acting_fn()``
+    (:class:`GaussianHead`), each :meth:`collect` acts with one taken at its start, the weights
+    being fixed during a batch). Episodes run on across
     :meth:`collect` calls; finished envs are reset (unseeded: each reset continues the task's
     generator) right after their last step.
 
@@ -145,6 +147,7 @@ class Rollout:
         leaves = {k: buf.get(k) for k in buf.keys(include_nested=True, leaves_only=True)}
         info_names = info_float_keys() + INFO_BOOL
         horizon = buf.shape[1]
+        actor = self.actor.acting_fn() if hasattr(self.actor, "acting_fn") else self.actor
         obs_s, nxt_s, info_s, rew_s, term_s, trunc_s = [], [], [], [], [], []
         act_s, loc_s, scale_s, noise_s, teacher_s = [], [], [], [], []
         for _ in range(horizon):
@@ -153,7 +156,7 @@ class Rollout:
             if self.teacher is not None:
                 base = self.teacher(self.task)
                 teacher_s.append(base)
-            loc, scale = self.actor(*self.obs)
+            loc, scale = actor(*self.obs)
             noise = torch.zeros_like(loc) if self.deterministic else self._noise(loc.shape)
             a = loc + scale * noise
             act_s.append(a), loc_s.append(loc), scale_s.append(scale), noise_s.append(noise)
