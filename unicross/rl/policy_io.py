@@ -117,9 +117,12 @@ def base_policy_of(ck: dict):
 
 def policy_fn(actor, base_policy=None):
     """``(obs, task) -> action`` of the bare network (its mean), on top of its base gait when it has
-    one (:func:`base_policy_of`): the way a checkpoint acts wherever it is evaluated."""
+    one (:func:`base_policy_of`): the way a checkpoint acts wherever it is evaluated. A network with
+    ``acting_fn()`` (:class:`GaussianHead`) acts through one taken now, with its observation
+    statistics as they are now: build a new ``policy_fn`` after they change."""
+    net = actor.acting_fn() if hasattr(actor, "acting_fn") else actor
     if base_policy is None:
-        return lambda obs, u: actor_action(actor, obs)
+        return lambda obs, u: actor_action(net, obs)
     from unicross.gaits import make_gait_policy
     gait = make_gait_policy(base_policy)
-    return lambda obs, u: actor_action(actor, obs, base=gait(obs, u))
+    return lambda obs, u: actor_action(net, obs, base=gait(obs, u))
