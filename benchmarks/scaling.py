@@ -6,7 +6,11 @@ training W:  ``unicross train``'s loop (lean collector with W worker processes, 
              each, GAE and the real PPO update at the default batch of 1024 frames), frames/s over
              ``--iterations`` iterations after one warm-up iteration;
 efficiency:  training W / (W x single env)  (target: >= 0.8 at 2 workers, issue "Training at the
-             speed of physics").
+             speed of physics");
+collect_efficiency:  the same for the collection alone (frames over the iterations' time outside the
+             update: waiting for the batch and the bookkeeping; None with ``collector.overlap``,
+             where that wait is not the collection's time): what the workers lose to one env
+             alone, before the update.
 
 ``--compare-overlap``: each worker count twice, collection then update (the default) and with
 ``collector.overlap`` (the workers collect the next batch during the update), in the same run.
@@ -74,8 +78,10 @@ def training_rate(workers: int, iterations: int, overrides: dict | None = None) 
         upd = sum(r["update_s"] for r in rows)
     finally:
         t.close()
+    overlapped = bool(t.overlap)
     return dict(workers=workers, frames_per_iteration=t.collector.frames_per_batch, training_fps=round(fps, 1),
                 collect_share=round(coll / (coll + upd), 3), update_share=round(upd / (coll + upd), 3),
+                collect_fps=None if overlapped else round((t.frames - f0) / coll, 1),
                 minibatch_steps=round(sum(r["minibatch_steps"] for r in rows) / len(rows), 1))
 
 
@@ -102,6 +108,7 @@ def main():
             r = training_rate(w, args.iterations, ov)
             r["overlap"] = bool(ov.get("collector", {}).get("overlap", False))
             r["efficiency"] = round(r["training_fps"] / (w * single), 3)
+            r["collect_efficiency"] = None if r["collect_fps"] is None else round(r["collect_fps"] / (w * single), 3)
             rows.append(r)
             print(json.dumps(r), flush=True)
     out = dict(single_env_steps_per_s=round(single, 1), cores=os.cpu_count(), settings=args.set or [], rows=rows)
