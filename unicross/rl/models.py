@@ -163,7 +163,8 @@ class GaussianHead(nn.Module):
         the three groups are normalised as one vector, and the layers run as plain functions. The
         weights are read live, the statistics and std as they are now: take a fresh one whenever
         they may have changed (:meth:`Rollout.collect` takes one per batch). Equal to ``forward`` to
-        rounding (the same element-wise operations)."""
+        rounding (the same element-wise operations). For acting only: no gradient reaches the
+        action std or the statistics through it (training uses :meth:`forward`)."""
         n, keys = self.net.norm, OBS_KEYS
         mean = torch.cat([getattr(n, f"{k}_mean") for k in keys])
         std = torch.cat([torch.sqrt(getattr(n, f"{k}_var") + 1e-8).clamp_min(n.std_min) for k in keys])
@@ -180,15 +181,17 @@ class GaussianHead(nn.Module):
 
 def _functional(seq: nn.Sequential):
     """``seq``'s forward without the per-module call overhead: ``Linear`` as ``F.linear`` on its live
-    weights, ``ELU`` in place on the fresh output before it; any other layer is called as is."""
-    steps = []
+    weights, an ``ELU`` right after a ``Linear`` in place on that fresh output; any other layer is
+    called as is."""
+    steps, prev = [], None
     for m in seq:
         if isinstance(m, nn.Linear):
             steps.append(lambda x, w=m.weight, b=m.bias: nn.functional.linear(x, w, b))
-        elif isinstance(m, nn.ELU) and steps:
+        elif isinstance(m, nn.ELU) and isinstance(prev, nn.Linear):
             steps.append(lambda x, a=m.alpha: nn.functional.elu(x, a, inplace=True))
         else:
             steps.append(m)
+        prev = m
 
     def run(x):
         for f in steps:
