@@ -38,6 +38,7 @@ import torch.multiprocessing as mp
 from tensordict import TensorDict
 
 from unicross.rl.env import INFO_BOOL, info_float_keys, obs_splitter
+from unicross.rl.models import acting
 from unicross.rl.policy_io import residual_action
 
 OBS_KEYS = ("hand", "object", "goal")
@@ -147,7 +148,7 @@ class Rollout:
         leaves = {k: buf.get(k) for k in buf.keys(include_nested=True, leaves_only=True)}
         info_names = info_float_keys() + INFO_BOOL
         horizon = buf.shape[1]
-        actor = self.actor.acting_fn() if hasattr(self.actor, "acting_fn") else self.actor
+        actor = acting(self.actor)
         obs_s, nxt_s, info_s, rew_s, term_s, trunc_s = [], [], [], [], [], []
         act_s, loc_s, scale_s, noise_s, teacher_s = [], [], [], [], []
         for _ in range(horizon):

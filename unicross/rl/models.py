@@ -179,6 +179,14 @@ class GaussianHead(nn.Module):
         return act
 
 
+
+def acting(actor):
+    """What to act with for a while of fixed weights and statistics: ``actor.acting_fn()`` where it
+    has one (:class:`GaussianHead`), else ``actor`` itself (any ``(hand, object, goal) -> (loc,
+    scale)`` module)."""
+    return actor.acting_fn() if hasattr(actor, "acting_fn") else actor
+
+
 def _functional(seq: nn.Sequential):
     """``seq``'s forward without the per-module call overhead: ``Linear`` as ``F.linear`` on its live
     weights, an ``ELU`` right after a ``Linear`` in place on that fresh output; any other layer is

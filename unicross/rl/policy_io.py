@@ -6,7 +6,7 @@ from pathlib import Path
 import torch
 
 from unicross.rl.env import split_obs
-from unicross.rl.models import make_models
+from unicross.rl.models import acting, make_models
 
 
 SHIPPED_DIR = Path(__file__).resolve().parent.parent / "checkpoints"
@@ -120,7 +120,7 @@ def policy_fn(actor, base_policy=None):
     one (:func:`base_policy_of`): the way a checkpoint acts wherever it is evaluated. A network with
     ``acting_fn()`` (:class:`GaussianHead`) acts through one taken now, with its observation
     statistics as they are now: build a new ``policy_fn`` after they change."""
-    net = actor.acting_fn() if hasattr(actor, "acting_fn") else actor
+    net = acting(actor)
     if base_policy is None:
         return lambda obs, u: actor_action(net, obs)
     from unicross.gaits import make_gait_policy
