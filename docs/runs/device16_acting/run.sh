@@ -13,6 +13,12 @@
 #     it runs beside scaling.py now), and the scaling run's cold compile (71 s in the main process, as
 #     long again in the workers) outlasted its 125 s timeout; no device time was left to rerun it;
 #     the timeouts below are raised for a rerun: 100 -> 200 s and 125 -> 250 s).
+#   bash docs/runs/device16_acting/run.sh 3
+#     call 2's measurements (call3/): first_call.py (a fresh process's first compiled step, Inductor's
+#     cache hits and misses logged) with an empty Inductor cache; the compiled overlapped scaling row;
+#     first_call.py again with the cache the others left (default compile threads, then
+#     TORCHINDUCTOR_COMPILE_THREADS=1: is a worker's ~40 s first call a miss, or a pool start?);
+#     the worker probe last.
 # From the repository root with the wheel bundle of ../shared/tools/device-wheels.sh in .whl.
 set -u
 export PYTHONUNBUFFERED=1
@@ -40,6 +46,26 @@ if [ "${1:-1}" = 1 ]; then
   run base eager 110
   run new compiled 190
   run base compiled 170
+elif [ "$1" = 3 ]; then
+  cp "$SRC/docs/runs/device16_acting/first_call.py" "$SRC/docs/runs/device16_acting/worker_probe.py" .
+  export TORCHINDUCTOR_CACHE_DIR=/tmp/inductor_call3 && rm -rf "$TORCHINDUCTOR_CACHE_DIR"
+  first_call() {  # tag [env]
+    el "first call, $1"
+    env ${2:-} TORCH_LOGS="+torch._inductor.codecache" PYTHONPATH=/tmp/site:/tmp/site_new timeout 120 \
+      python3 first_call.py > "$OUT/first_call_$1.json" 2> "$OUT/first_call_$1.err"
+    echo "  fx graph cache hits $(grep -c 'fx graph cache hit' "$OUT/first_call_$1.err")," \
+      "misses $(grep -c 'fx graph cache miss' "$OUT/first_call_$1.err")" | tee -a "$OUT/log.txt"
+    grep "first_step_s\|make_and_reset_s" "$OUT/first_call_$1.json" | tee -a "$OUT/log.txt"
+  }
+  first_call cold
+  el "scaling, new, compiled, overlap"
+  PYTHONPATH=/tmp/site:/tmp/site_new timeout 200 python3 scaling.py --workers 2 --iterations 8 \
+    --set collector.overlap=true --json "$OUT/scaling_compiled_new_overlap.json" 2>&1 | grep -v -i warn >> "$OUT/log.txt"
+  first_call warm
+  first_call warm_threads1 TORCHINDUCTOR_COMPILE_THREADS=1
+  el "worker probe, compiled"
+  PYTHONPATH=/tmp/site:/tmp/site_new timeout 150 python3 worker_probe.py 6 \
+    > "$OUT/worker_probe.json" 2> >(grep -v -i warn >> "$OUT/log.txt")
 else
   el "worker probe, compiled"
   cp "$SRC/docs/runs/device16_acting/worker_probe.py" .  # beside scaling.py, outside the source tree
