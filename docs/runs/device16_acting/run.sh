@@ -19,6 +19,10 @@
 #     first_call.py again with the cache the others left (default compile threads, then
 #     TORCHINDUCTOR_COMPILE_THREADS=1: is a worker's ~40 s first call a miss, or a pool start?);
 #     the worker probe last.
+#   bash docs/runs/device16_acting/run.sh 4
+#     where a process's ~1 min start goes (call4/): the time of CUDA's first init in a process on this
+#     machine; first_call.py (now profiling make + reset + first step) with no GPU visible
+#     (CUDA_VISIBLE_DEVICES=) on an empty cache, again on the cache it left, then with the GPU visible.
 # From the repository root with the wheel bundle of ../shared/tools/device-wheels.sh in .whl.
 set -u
 export PYTHONUNBUFFERED=1
@@ -46,17 +50,26 @@ if [ "${1:-1}" = 1 ]; then
   run base eager 110
   run new compiled 190
   run base compiled 170
-elif [ "$1" = 3 ]; then
+elif [ "$1" = 3 ] || [ "$1" = 4 ]; then
   cp "$SRC/docs/runs/device16_acting/first_call.py" "$SRC/docs/runs/device16_acting/worker_probe.py" .
   export TORCHINDUCTOR_CACHE_DIR=/tmp/inductor_call3 && rm -rf "$TORCHINDUCTOR_CACHE_DIR"
-  first_call() {  # tag [env]
+  first_call() {  # tag [env [timeout]]
     el "first call, $1"
-    env ${2:-} TORCH_LOGS="+torch._inductor.codecache" PYTHONPATH=/tmp/site:/tmp/site_new timeout 120 \
+    env ${2:-} TORCH_LOGS="+torch._inductor.codecache" PYTHONPATH=/tmp/site:/tmp/site_new timeout ${3:-120} \
       python3 first_call.py > "$OUT/first_call_$1.json" 2> "$OUT/first_call_$1.err"
     echo "  fx graph cache hits $(grep -c 'fx graph cache hit' "$OUT/first_call_$1.err")," \
       "misses $(grep -c 'fx graph cache miss' "$OUT/first_call_$1.err")" | tee -a "$OUT/log.txt"
     grep "first_step_s\|make_and_reset_s" "$OUT/first_call_$1.json" | tee -a "$OUT/log.txt"
   }
+  if [ "$1" = 4 ]; then
+    el "CUDA init"
+    PYTHONPATH=/tmp/site timeout 40 python3 -c "import time, torch; t = time.perf_counter(); torch.cuda.init(); \
+print('cuda init', round(time.perf_counter() - t, 2), 's', torch.cuda.get_device_name())" 2>&1 | tee -a "$OUT/log.txt"
+    first_call cold_nogpu CUDA_VISIBLE_DEVICES= 100
+    first_call warm_nogpu CUDA_VISIBLE_DEVICES= 35
+    first_call warm_gpu "" 70
+    el done; exit 0
+  fi
   first_call cold
   el "scaling, new, compiled, overlap"
   PYTHONPATH=/tmp/site:/tmp/site_new timeout 200 python3 scaling.py --workers 2 --iterations 8 \
