@@ -6,7 +6,10 @@ training W:  ``unicross train``'s loop (lean collector with W worker processes, 
              each, GAE and the real PPO update at the default batch of 1024 frames), frames/s over
              ``--iterations`` iterations after one warm-up iteration;
 efficiency:  training W / (W x single env)  (target: >= 0.8 at 2 workers, issue "Training at the
-             speed of physics");
+             speed of physics"); the single env is measured before and after the training rows and
+             the ratio uses their mean (``efficiency_range``: against the faster and the slower of
+             the two; a machine whose speed drifts during the run shows here, and the script warns
+             when the two differ by more than 15%);
 collect_efficiency:  the same for the collection alone (frames over the iterations' time outside the
              update: waiting for the batch and the bookkeeping; None with ``collector.overlap``,
              where that wait is not the collection's time): what the workers lose to one env
@@ -99,7 +102,7 @@ def main():
     if args.compare_overlap and min(args.workers) < 2:
         p.error("--compare-overlap needs >= 2 workers (overlapped collection runs in worker processes)")
     overrides = parse_sets(args.set)
-    single = single_env_rate(args.env_steps)
+    single_before = single_env_rate(args.env_steps)
     rows = []
     for w in args.workers:
         for overlap in ((False, True) if args.compare_overlap else (None,)):
@@ -107,11 +110,23 @@ def main():
                                                              strict=False)
             r = training_rate(w, args.iterations, ov)
             r["overlap"] = bool(ov.get("collector", {}).get("overlap", False))
-            r["efficiency"] = round(r["training_fps"] / (w * single), 3)
-            r["collect_efficiency"] = None if r["collect_fps"] is None else round(r["collect_fps"] / (w * single), 3)
             rows.append(r)
             print(json.dumps(r), flush=True)
-    out = dict(single_env_steps_per_s=round(single, 1), cores=os.cpu_count(), settings=args.set or [], rows=rows)
+    single_after = single_env_rate(args.env_steps, seed=1)
+    single = (single_before + single_after) / 2
+    lo, hi = sorted((single_before, single_after))
+    if hi > 1.15 * lo:
+        print(f"warning: one env alone ran at {single_before:.0f} steps/s before the training rows and "
+              f"{single_after:.0f} after: this machine's speed drifted; the efficiencies use their mean",
+              file=sys.stderr, flush=True)
+    for r in rows:
+        w = r["workers"]
+        r["efficiency"] = round(r["training_fps"] / (w * single), 3)
+        r["efficiency_range"] = [round(r["training_fps"] / (w * hi), 3), round(r["training_fps"] / (w * lo), 3)]
+        r["collect_efficiency"] = None if r["collect_fps"] is None else round(r["collect_fps"] / (w * single), 3)
+    out = dict(single_env_steps_per_s=round(single, 1),
+               single_env_before_after=[round(single_before, 1), round(single_after, 1)],
+               cores=os.cpu_count(), settings=args.set or [], rows=rows)
     print(json.dumps(out, indent=1))
     if args.json:
         with open(args.json, "w") as f:
