@@ -169,3 +169,42 @@ def test_a_reversed_gait_runs_the_same_loop_backwards_and_is_a_gait_for_the_oppo
     assert torch.allclose(a_b[0, 6:], want_b.clamp(-1, 1), atol=1e-5) and not torch.allclose(a_f, a_b)
     with pytest.raises(ValueError, match="reverse must be 0 or 1"):
         make_gait_policy("allegro/rotate_y-,reverse=2")
+
+
+def test_the_guard_pauses_the_gait_and_tightens_while_too_few_links_touch(tmp_path):
+    """``guard=K``: with fewer than K links in contact the clock gait stands still and the fingers close
+    along the closing direction by GUARD_RATE a step (at most guard_max); with enough contact it is
+    the plain gait, its clock counting only the steps it ran."""
+    from unicross.gaits import GUARD_RATE, gait_offsets
+    from robots.hand import load_hand
+    from unicross.scripted_grasp import closing_direction
+    g = torch.Generator().manual_seed(2)
+    _write(tmp_path / "log.jsonl", [dict(meta=dict(amplitude=1.0), p=(torch.rand(NPAR, generator=g) * 2 - 1).tolist(),
+                                         score=1.0)])
+    p = best_gait(str(tmp_path / "log.jsonl"))[0]
+    guarded = make_gait_policy(str(tmp_path / "log.jsonl"), guard=2, guard_max=0.05)
+    plain = make_gait_policy(str(tmp_path / "log.jsonl"))
+    u, v = _stand_in_env(1, "rotate_y-", [0.0, -1.0, 0.0]), _stand_in_env(1, "rotate_y-", [0.0, -1.0, 0.0])
+    u.hand_spec = v.hand_spec = load_hand("allegro")
+    u.action_scale = v.action_scale = torch.full((22,), 10.0)  # no clamp
+    closing = closing_direction(u.hand_spec)
+    contact = torch.zeros(1, 16)
+    u._obs_parts = dict(contact=contact)
+    contact[0, :3] = 1.0  # three links touch: the plain gait
+    for t in range(3):
+        u.elapsed_steps[:] = v.elapsed_steps[:] = t
+        a, b = guarded(None, u), plain(None, v)
+        torch.testing.assert_close(a, b)
+        u.command[:, 6:] += a[:, 6:] * 10.0
+        v.command[:, 6:] += b[:, 6:] * 10.0
+    contact[0, 1:] = 0.0  # one link: the gait pauses at its clock 3 and closes the grasp, up to guard_max
+    for t, tight in ((3, GUARD_RATE), (4, 2 * GUARD_RATE), (5, 0.05), (6, 0.05)):
+        u.elapsed_steps[:] = t
+        u.command[:, 6:] += guarded(None, u)[:, 6:] * 10.0
+        torch.testing.assert_close(u.command[0, 6:], gait_offsets(p, torch.tensor(3.0)) + tight * closing, atol=1e-5, rtol=0)
+    contact[0, :3] = 1.0  # contact back: the gait goes on from its clock 4, around the tightened grasp
+    u.elapsed_steps[:] = 7
+    u.command[:, 6:] += guarded(None, u)[:, 6:] * 10.0
+    torch.testing.assert_close(u.command[0, 6:], gait_offsets(p, torch.tensor(4.0)) + 0.05 * closing, atol=1e-5, rtol=0)
+    with pytest.raises(ValueError, match="guard"):
+        make_gait_policy(str(tmp_path / "log.jsonl"), guard=-1)

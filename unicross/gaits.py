@@ -73,12 +73,12 @@ def gait_targets(p, t: int, q0: torch.Tensor) -> torch.Tensor:
 SHIPPED_DIR = Path(__file__).resolve().parent / "checkpoints"
 
 
-GAIT_OPTIONS = {"tracking": str, "lookahead": float, "grid": int, "reverse": int}
+GAIT_OPTIONS = {"tracking": str, "lookahead": float, "grid": int, "reverse": int, "guard": int, "guard_max": float}
 
 
 def split_gait_spec(spec: str) -> Tuple[str, dict]:
     """(gait, options) of ``GAIT[,key=value...]``, the options of :func:`make_gait_policy`
-    (``tracking``, ``lookahead``, ``grid``, ``reverse``), e.g. ``allegro/rotate_y-,tracking=phase,lookahead=1.5``
+    (``tracking``, ``lookahead``, ``grid``, ``reverse``, ``guard``, ``guard_max``), e.g. ``allegro/rotate_y-,tracking=phase,lookahead=1.5``
     or ``allegro/rotate_y-,reverse=1`` (the y- gait run backwards, :func:`reverse_gait`)."""
     base, *rest = spec.split(",")
     opts = {}
@@ -153,7 +153,11 @@ def gait_mode(row: dict) -> str:
 TRACKING = ("clock", "phase")
 
 
-def make_gait_policy(spec: str, tracking: str = "clock", lookahead: float = 1.0, grid: int = 8, reverse: int = 0):
+GUARD_RATE = 0.02  # rad a control step along the closing direction while a guard tightens the grasp
+
+
+def make_gait_policy(spec: str, tracking: str = "clock", lookahead: float = 1.0, grid: int = 8, reverse: int = 0,
+                     guard: int = 0, guard_max: float = 0.15):
     """The scripted in-hand policy of the best gait in ``spec`` (a log, or a shipped gait's
     ``<hand>/<mode>``; see the module docstring). Options written into ``spec`` after commas
     (``allegro/rotate_y-,tracking=phase,lookahead=1.5``; :func:`split_gait_spec`) override the
@@ -172,10 +176,19 @@ def make_gait_policy(spec: str, tracking: str = "clock", lookahead: float = 1.0,
 
     ``reverse=1``: the gait run backwards in time (:func:`reverse_gait`); the stop still follows
     the env's own axis, so ``allegro/rotate_y-,reverse=1`` on a y+ env stops at a y+ success.
+
+    ``guard=K`` (0: off): a reaction to slipping, from the observation's contact flags. While fewer than
+    K contact links touch the object, the gait pauses (its clock, or with ``tracking=phase`` its
+    lookahead, stands still) and the fingers close along the hand's closing direction by
+    ``GUARD_RATE`` a step, up to ``guard_max`` rad in all; the gait then goes on around the tightened
+    grasp (the tightening stays).
     """
     spec, opts = split_gait_spec(spec)
     tracking, lookahead, grid = opts.get("tracking", tracking), opts.get("lookahead", lookahead), opts.get("grid", grid)
     reverse = opts.get("reverse", reverse)
+    guard, guard_max = opts.get("guard", guard), opts.get("guard_max", guard_max)
+    if guard < 0 or guard_max < 0:
+        raise ValueError(f"gait guard and guard_max must be >= 0, got {guard} and {guard_max}")
     if tracking not in TRACKING:
         raise ValueError(f"gait tracking must be one of {TRACKING}, got {tracking!r}")
     if grid < 1:
@@ -204,18 +217,34 @@ def make_gait_policy(spec: str, tracking: str = "clock", lookahead: float = 1.0,
             state.update(env=u, q0=u.command[:, 6:].clone(), is_rot=is_rot,
                          threshold=torch.where(is_rot, sc["rotate_angle"], sc["translate_dist"]),
                          motion=torch.zeros(u.num_envs, device=u.device),
-                         done=torch.zeros(u.num_envs, dtype=torch.bool, device=u.device))
+                         done=torch.zeros(u.num_envs, dtype=torch.bool, device=u.device),
+                         clock=torch.zeros(u.num_envs, device=u.device),
+                         tight=torch.zeros(u.num_envs, 1, device=u.device))
+            if guard > 0:
+                from unicross.scripted_grasp import closing_direction
+                state["closing"] = closing_direction(u.hand_spec).to(u.device)[None]
         else:  # the motion of the step just taken, about / along the env's axis
             vel = torch.where(state["is_rot"][:, None], u.obj_angvel_h, u.obj_vel_h)
             state["motion"] += (vel * u.axis).sum(-1) * u.control_dt
         state["done"] |= state["motion"] > state["threshold"]
         a = torch.zeros(u.num_envs, u.hand_spec.dof, device=u.device)
+        slipping = torch.zeros(u.num_envs, dtype=torch.bool, device=u.device)
+        if guard > 0:
+            slipping = (u._obs_parts["contact"] > 0).sum(-1) < guard
+            state["tight"] = torch.where(slipping[:, None], (state["tight"] + GUARD_RATE).clamp(max=guard_max),
+                                         state["tight"])
+        centre = state["q0"] + state["tight"] * state["closing"] if guard > 0 else state["q0"]  # tightened by the guard
         if tracking == "clock":
-            target = gait_targets(p, t + 1, state["q0"])
+            if guard > 0:  # the gait's own clock, which stands still while the guard tightens
+                state["clock"] += (~slipping).float()
+                target = centre + gait_offsets(p, state["clock"][:, None].double()).squeeze(1).to(u.device)
+            else:
+                target = gait_targets(p, t + 1, state["q0"])
         else:
-            rel = u.command[:, 6:] - state["q0"]  # [N, 16]
+            rel = u.command[:, 6:] - centre  # [N, 16]
             k = ((cycle.to(u.device)[None] - rel[:, None]) ** 2).sum(-1).argmin(1)  # [N]
-            target = state["q0"] + gait_offsets(p, taus.to(u.device)[k] + lookahead)
+            ahead = torch.where(slipping, 0.0, lookahead)
+            target = centre + gait_offsets(p, taus.to(u.device)[k] + ahead)
         step = ((target - u.command[:, 6:]) / u.action_scale[6:]).clamp(-1, 1)
         a[:, 6:] = torch.where(state["done"][:, None], torch.zeros_like(step), step)
         return a
