@@ -23,6 +23,8 @@
 #     where a process's ~1 min start goes (call4/): the time of CUDA's first init in a process on this
 #     machine; first_call.py (now profiling make + reset + first step) with no GPU visible
 #     (CUDA_VISIBLE_DEVICES=) on an empty cache, again on the cache it left, then with the GPU visible.
+#     Call 4 ran it with timeouts of 100 / 35 / 70 s: the cold compile did not finish and nothing was
+#     measured; the timeouts are now 200 / 120 / 120 s (call it with timeout_s >= 500).
 # From the repository root with the wheel bundle of ../shared/tools/device-wheels.sh in .whl.
 set -u
 export PYTHONUNBUFFERED=1
@@ -65,9 +67,9 @@ elif [ "$1" = 3 ] || [ "$1" = 4 ]; then
     el "CUDA init"
     PYTHONPATH=/tmp/site timeout 40 python3 -c "import time, torch; t = time.perf_counter(); torch.cuda.init(); \
 print('cuda init', round(time.perf_counter() - t, 2), 's', torch.cuda.get_device_name())" 2>&1 | tee -a "$OUT/log.txt"
-    first_call cold_nogpu CUDA_VISIBLE_DEVICES= 100
-    first_call warm_nogpu CUDA_VISIBLE_DEVICES= 35
-    first_call warm_gpu "" 70
+    first_call cold_nogpu CUDA_VISIBLE_DEVICES= 200
+    first_call warm_nogpu CUDA_VISIBLE_DEVICES= 120
+    first_call warm_gpu "" 120
     el done; exit 0
   fi
   first_call cold
