@@ -24,6 +24,7 @@ from typing import Tuple
 import torch
 
 from unicross import formulation as F
+from unicross.observations import contact as observed_contact
 
 NPAR = 6 * 4 + 1
 ROTATE_MODES = torch.tensor([F.mode_skill(m) == "rotate" for m in F.MODES])  # [modes]: rotation (else translation)
@@ -230,7 +231,7 @@ def make_gait_policy(spec: str, tracking: str = "clock", lookahead: float = 1.0,
         a = torch.zeros(u.num_envs, u.hand_spec.dof, device=u.device)
         slipping = torch.zeros(u.num_envs, dtype=torch.bool, device=u.device)
         if guard > 0:
-            slipping = (u._obs_parts["contact"] > 0).sum(-1) < guard
+            slipping = (observed_contact(u) > 0).sum(-1) < guard  # the observation's contact flags
             state["tight"] = torch.where(slipping[:, None], (state["tight"] + GUARD_RATE).clamp(max=guard_max),
                                          state["tight"])
         centre = state["q0"] + state["tight"] * state["closing"] if guard > 0 else state["q0"]  # tightened by the guard
