@@ -238,7 +238,7 @@ def make_gait_policy(spec: str, tracking: str = "clock", lookahead: float = 1.0,
         if tracking == "clock":
             if guard > 0:  # the gait's own clock, which stands still while the guard tightens
                 state["clock"] += (~slipping).float()
-                target = centre + gait_offsets(p, state["clock"][:, None].double()).squeeze(1).to(u.device)
+                target = centre + gait_offsets(p, state["clock"].double()).to(u.device)
             else:
                 target = gait_targets(p, t + 1, state["q0"])
         else:
