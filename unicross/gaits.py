@@ -218,23 +218,23 @@ def make_gait_policy(spec: str, tracking: str = "clock", lookahead: float = 1.0,
             state.update(env=u, q0=u.command[:, 6:].clone(), is_rot=is_rot,
                          threshold=torch.where(is_rot, sc["rotate_angle"], sc["translate_dist"]),
                          motion=torch.zeros(u.num_envs, device=u.device),
-                         done=torch.zeros(u.num_envs, dtype=torch.bool, device=u.device),
-                         clock=torch.zeros(u.num_envs, device=u.device),
-                         tight=torch.zeros(u.num_envs, 1, device=u.device))
-            if guard > 0:
+                         done=torch.zeros(u.num_envs, dtype=torch.bool, device=u.device))
+            if guard > 0:  # the guard's own clock, its tightening so far, and the direction it tightens
                 from unicross.scripted_grasp import closing_direction
-                state["closing"] = closing_direction(u.hand_spec).to(u.device)[None]
+                state.update(clock=torch.zeros(u.num_envs, device=u.device),
+                             tight=torch.zeros(u.num_envs, 1, device=u.device),
+                             closing=closing_direction(u.hand_spec).to(u.device)[None])
         else:  # the motion of the step just taken, about / along the env's axis
             vel = torch.where(state["is_rot"][:, None], u.obj_angvel_h, u.obj_vel_h)
             state["motion"] += (vel * u.axis).sum(-1) * u.control_dt
         state["done"] |= state["motion"] > state["threshold"]
         a = torch.zeros(u.num_envs, u.hand_spec.dof, device=u.device)
-        slipping = torch.zeros(u.num_envs, dtype=torch.bool, device=u.device)
+        centre = state["q0"]  # the gait's centre: the start command, tightened by the guard
         if guard > 0:
             slipping = (observed_contact(u) > 0).sum(-1) < guard  # the observation's contact flags
             state["tight"] = torch.where(slipping[:, None], (state["tight"] + GUARD_RATE).clamp(max=guard_max),
                                          state["tight"])
-        centre = state["q0"] + state["tight"] * state["closing"] if guard > 0 else state["q0"]  # tightened by the guard
+            centre = centre + state["tight"] * state["closing"]
         if tracking == "clock":
             if guard > 0:  # the gait's own clock, which stands still while the guard tightens
                 state["clock"] += (~slipping).float()
@@ -244,7 +244,7 @@ def make_gait_policy(spec: str, tracking: str = "clock", lookahead: float = 1.0,
         else:
             rel = u.command[:, 6:] - centre  # [N, 16]
             k = ((cycle.to(u.device)[None] - rel[:, None]) ** 2).sum(-1).argmin(1)  # [N]
-            ahead = torch.where(slipping, 0.0, lookahead)
+            ahead = torch.where(slipping, 0.0, lookahead) if guard > 0 else lookahead
             target = centre + gait_offsets(p, taus.to(u.device)[k] + ahead)
         step = ((target - u.command[:, 6:]) / u.action_scale[6:]).clamp(-1, 1)
         a[:, 6:] = torch.where(state["done"][:, None], torch.zeros_like(step), step)

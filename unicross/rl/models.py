@@ -179,7 +179,6 @@ class GaussianHead(nn.Module):
         return act
 
 
-
 def acting(actor):
     """What to act with for a while of fixed weights and statistics: ``actor.acting_fn()`` where it
     has one (:class:`GaussianHead`), else ``actor`` itself (any ``(hand, object, goal) -> (loc,
