@@ -32,16 +32,17 @@ def test_shards_together_give_the_unsharded_trials(grasp_file, tiny_objects):
 
 
 def test_reference_policy_slides_the_object_out_and_is_refused_without_a_reference(grasp_file, tiny_objects, tmp_path):
-    """``--policy reference``: translate z+'s physical reference (opening the fingers) translates
-    the object where the zero action does not; a mode without a reference is refused before
-    any simulation."""
-    kw = dict(grasp_dataset=grasp_file, trials_per_object=2, seed=0, progress=False, axes=["z+"])
-    ref = E.summarize("translate", E.run_protocol("translate", E.resolve_policy("reference@0.75", "allegro")[0],
-                                                  tiny_objects, **kw))
-    zero = E.summarize("translate", E.run_protocol("translate", E.zero_policy, tiny_objects, **kw))
-    assert ref["trans_cm"] > zero["trans_cm"] + 2.0, (ref, zero)  # measured: +2.9 vs +0.02 cm
-    assert cli(["eval", "--policy", "reference", "--protocol", "translate", "--objects", "test", "--limit", "1",
-                "--out", str(tmp_path / "e.json")]) == 2  # z- has none
+    """``--policy reference``: translate's physical references (z+: opening the fingers; z-: curling
+    the index finger's distal joints) translate the object along their direction where the zero
+    action does not; a mode without a reference is refused before any simulation."""
+    for axis, fraction, margin in (("z+", "0.75", 2.0), ("z-", "1", 1.0)):
+        kw = dict(grasp_dataset=grasp_file, trials_per_object=2, seed=0, progress=False, axes=[axis])
+        ref = E.summarize("translate", E.run_protocol("translate", E.resolve_policy(f"reference@{fraction}", "allegro")[0],
+                                                      tiny_objects, **kw))
+        zero = E.summarize("translate", E.run_protocol("translate", E.zero_policy, tiny_objects, **kw))
+        assert ref["trans_cm"] > zero["trans_cm"] + margin, (axis, ref, zero)  # measured: z+ +2.9 vs +0.02 cm
+    assert cli(["eval", "--policy", "reference", "--protocol", "rotate", "--objects", "test", "--limit", "1",
+                "--out", str(tmp_path / "e.json")]) == 2  # rotation has none
     assert not (tmp_path / "e.json").exists()
     with pytest.raises(ValueError, match="reference@FRACTION"):
         E.resolve_policy("reference@x", "allegro")

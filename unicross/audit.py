@@ -36,7 +36,7 @@ and more for every step on the way there (:func:`ascent`: the same sweep at a fr
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Callable, Dict, List, Optional
+from typing import Callable, Dict, List, Optional, Tuple
 
 import gymnasium as gym
 import torch
@@ -101,21 +101,29 @@ def _naive_relocate(u):
     return lambda: scripted_relocate_policy(None, u)
 
 
-def finger_sweep_action(hand_spec, rate: float) -> torch.Tensor:
+def finger_sweep_action(hand_spec, rate: float, joints: Optional[Tuple[str, int]] = None) -> torch.Tensor:
     """The constant normalised action [dof] that moves the finger targets ``rate`` rad per control
     step along the closing direction (negative: opening), the fastest joint by ``|rate|``, with a
-    zero wrist residual."""
+    zero wrist residual. ``joints = (finger, k)`` moves only that finger's ``k`` most distal joints
+    (at the same per-joint rates), the others hold."""
     from unicross.scripted_grasp import closing_direction
     scale = torch.as_tensor(hand_spec.action_scales(), dtype=torch.float32)
     a = torch.zeros(hand_spec.dof)
     a[6:] = (rate * closing_direction(hand_spec) / scale[6:]).clamp(-1.0, 1.0)
+    if joints is not None:
+        finger, k = joints
+        if finger not in hand_spec.fingers:
+            raise ValueError(f"hand {hand_spec.name!r} has no finger {finger!r}; its fingers: {list(hand_spec.fingers)}")
+        moving = set(hand_spec.fingers[finger][-k:])
+        keep = torch.tensor([j in moving for j in hand_spec.finger_joints])
+        a[6:] = torch.where(keep, a[6:], torch.zeros_like(a[6:]))
     return a
 
 
-def _finger_sweep(rate: float):
+def _finger_sweep(rate: float, joints: Optional[Tuple[str, int]] = None):
     """:func:`finger_sweep_action` at every step."""
     def make(u):
-        a = finger_sweep_action(u.hand_spec, rate).to(u.device)
+        a = finger_sweep_action(u.hand_spec, rate, joints).to(u.device)
         return lambda: a.expand(u.num_envs, -1).clone()
     return make
 
@@ -148,7 +156,12 @@ def _oracle(u):
     return _zero(u)
 
 
-PHYSICAL_REFERENCES = {("translate", "z+"): ("open", -0.02)}  # (skill, axis) -> (behaviour, finger rate)
+# (skill, axis) -> (behaviour, finger rate, joints: None = every finger joint, or (finger, k): its k
+# most distal joints; see finger_sweep_action). Translate z+: opening slides the object out along the
+# fingers. Translate z-: curling the index finger's two distal joints pushes it toward the wrist
+# (closing every finger moves it only 1.7-2.3 cm; docs/runs/translate_zm_reference/)
+PHYSICAL_REFERENCES = {("translate", "z+"): ("open", -0.02, None),
+                       ("translate", "z-"): ("pull", 0.05, ("index", 2))}
 ASCENT_FRACTIONS = (0.0, 0.125, 0.25, 0.375, 0.5, 0.75, 1.0)
 
 
@@ -160,7 +173,8 @@ def physical_reference(skill: str, axis: Optional[str]) -> Optional[str]:
 
 
 def _reference(skill: str, axis: Optional[str]):
-    """(behaviour name, finger rate) of the physical reference of (skill, axis); refuses a mode without one."""
+    """(behaviour name, finger rate, joints) of the physical reference of (skill, axis); refuses a mode
+    without one."""
     if (skill, axis) not in PHYSICAL_REFERENCES:
         raise ValueError(f"no physical reference for {skill} {axis}; known: {sorted(PHYSICAL_REFERENCES)}")
     return PHYSICAL_REFERENCES[(skill, axis)]
@@ -171,14 +185,15 @@ def ascent_behaviours(skill: str, axis: Optional[str], fractions=ASCENT_FRACTION
     named ``<reference>@<fraction>``. PPO starts near the zero action and follows the gradient of
     the return: the reward gives it a path to the reference only when the return rises along the
     way, not just at the end (:func:`ascent`)."""
-    name, rate = _reference(skill, axis)
-    return {f"{name}@{f:g}": _finger_sweep(rate * f) for f in fractions}
+    name, rate, joints = _reference(skill, axis)
+    return {f"{name}@{f:g}": _finger_sweep(rate * f, joints) for f in fractions}
 
 
 def reference_action(skill: str, axis: Optional[str], hand_spec, fraction: float = 1.0) -> torch.Tensor:
     """The constant normalised action [dof] of the physical reference of (``skill``, ``axis``) at
     ``fraction`` of its rate: what ``model.init_reference`` starts a policy's mean at."""
-    return finger_sweep_action(hand_spec, _reference(skill, axis)[1] * fraction)
+    _, rate, joints = _reference(skill, axis)
+    return finger_sweep_action(hand_spec, rate * fraction, joints)
 
 
 def ascent(skill: str, axis: Optional[str], fractions=ASCENT_FRACTIONS, **audit_kw) -> List["AuditRow"]:
@@ -205,7 +220,8 @@ def _gait(spec: str):
 def behaviours(skill: str, seed: int = 0, axis: Optional[str] = None, hand: str = "allegro") -> Dict[str, Callable]:
     """name -> factory(u) -> act() for the reference behaviours of ``skill``; the first is the
     successful reference. With ``axis``, a mode with a shipped scripted gait (:mod:`unicross.gaits`)
-    also lists it as ``gait``."""
+    also lists it as ``gait``, and one with a physical reference other than opening or closing every
+    finger (translate z-: ``pull``) lists that."""
     common = dict(zero=_zero, random=_random_factory(seed))
     if skill == "grasp":
         return dict(scripted=_grasp_script(lift=True, close=True, descend=True),
@@ -218,7 +234,9 @@ def behaviours(skill: str, seed: int = 0, axis: Optional[str] = None, hand: str 
     if skill in ("rotate", "translate"):
         from unicross.gaits import shipped_gaits
         gait = shipped_gaits(hand).get(f"{skill}_{axis}") if axis else None
-        return dict(oracle=_oracle, **(dict(gait=_gait(gait)) if gait else {}), zero=common["zero"],
+        ref = PHYSICAL_REFERENCES.get((skill, axis))
+        extra = {ref[0]: _finger_sweep(ref[1], ref[2])} if ref and ref[0] not in ("open", "close") else {}
+        return dict(oracle=_oracle, **(dict(gait=_gait(gait)) if gait else {}), **extra, zero=common["zero"],
                     open=_finger_sweep(-0.02), close=_finger_sweep(0.02), random=common["random"])
     raise ValueError(f"unknown skill {skill!r}; valid: grasp, relocate, rotate, translate")
 
