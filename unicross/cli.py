@@ -539,7 +539,7 @@ def main(argv=None) -> int:
     s = sub.add_parser("eval", help="run the paper's evaluation protocols; writes JSON (every trial) and a table")
     s.add_argument("--policy", required=True,
                    help="checkpoint path, or zero | random | scripted-grasp | scripted-relocate | reference[@FRACTION] "
-                        "(the physical reference: translate z+) | gait:LOG or gait:allegro/rotate_y- (the best finger gait "
+                        "(the physical reference: translate z+ opens the fingers, z- curls the index) | gait:LOG or gait:allegro/rotate_y- (the best finger gait "
                         "of a benchmarks/gait_search.py log, or a shipped one, run until the mode is done, then holding)")
     s.add_argument("--protocol", default="all", help="grasp, relocate, rotate, translate (comma list) or all")
     s.add_argument("--objects", default="test", help="object set: train | test | unseen (| -wrappable/-elongated | mesh:<file>)")
@@ -626,7 +626,7 @@ def main(argv=None) -> int:
     s.add_argument("--seeds", type=positive, default=3, help="episodes per object and behaviour")
     s.add_argument("--only", default=None, help="comma list of behaviours (default: all)")
     s.add_argument("--ascent", action="store_true",
-                   help="instead: the mode's physical reference at fractions of its rate, in order (translate z+)")
+                   help="instead: the mode's physical reference at fractions of its rate, in order (translate z+ and z-)")
     s.add_argument("--hand", default="allegro")
     s.add_argument("--preset", action="append", metavar="NAME", help="configs/presets/NAME.yaml (e.g. paper_reward)")
     s.add_argument("--set", action="append", metavar="SECTION.KEY=VALUE", help="override configs/ppo.yaml")

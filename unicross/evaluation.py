@@ -22,7 +22,7 @@ The protocol settings (trials per object, disturbance scale, PE/AE window) are i
 
 Policies: a checkpoint path, ``zero`` (no action), ``random``, ``scripted-relocate`` (the
 paper's naive relocation baseline) or ``reference[@FRACTION]`` (the mode's physical reference,
-where one is known: translate z+ opens the fingers) or ``gait:LOG`` / ``gait:<hand>/<mode>`` (the best finger
+where one is known: translate z+ opens the fingers, z- curls the index finger) or ``gait:LOG`` / ``gait:<hand>/<mode>`` (the best finger
 gait of a ``benchmarks/gait_search.py`` log or a shipped one, run until the mode's threshold is
 passed, then holding: :mod:`unicross.gaits`). Same seed and policy give identical results.
 """
@@ -113,7 +113,7 @@ def make_scripted_grasp_policy() -> PolicyFn:
 
 def make_reference_policy(fraction: float = 1.0) -> PolicyFn:
     """The mode's physical reference (:data:`unicross.audit.PHYSICAL_REFERENCES`; translate z+:
-    opening the fingers) at ``fraction`` of its rate: a constant scripted action, the bar beyond
+    opening the fingers, z-: curling the index finger) at ``fraction`` of its rate: a constant scripted action, the bar beyond
     the zero action that an expert of that mode should beat."""
     from unicross.audit import reference_action
     from unicross.registry import mode_axis
