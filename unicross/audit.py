@@ -115,8 +115,7 @@ def finger_sweep_action(hand_spec, rate: float, joints: Optional[Tuple[str, int]
         if finger not in hand_spec.fingers:
             raise ValueError(f"hand {hand_spec.name!r} has no finger {finger!r}; its fingers: {list(hand_spec.fingers)}")
         moving = set(hand_spec.fingers[finger][-k:])
-        keep = torch.tensor([j in moving for j in hand_spec.finger_joints])
-        a[6:] = torch.where(keep, a[6:], torch.zeros_like(a[6:]))
+        a[6:] *= torch.tensor([j in moving for j in hand_spec.finger_joints])
     return a
 
 
@@ -220,8 +219,8 @@ def _gait(spec: str):
 def behaviours(skill: str, seed: int = 0, axis: Optional[str] = None, hand: str = "allegro") -> Dict[str, Callable]:
     """name -> factory(u) -> act() for the reference behaviours of ``skill``; the first is the
     successful reference. With ``axis``, a mode with a shipped scripted gait (:mod:`unicross.gaits`)
-    also lists it as ``gait``, and one with a physical reference other than opening or closing every
-    finger (translate z-: ``pull``) lists that."""
+    also lists it as ``gait``, and one with a physical reference not listed already (translate z-:
+    ``pull``) lists that."""
     common = dict(zero=_zero, random=_random_factory(seed))
     if skill == "grasp":
         return dict(scripted=_grasp_script(lift=True, close=True, descend=True),
@@ -234,10 +233,12 @@ def behaviours(skill: str, seed: int = 0, axis: Optional[str] = None, hand: str 
     if skill in ("rotate", "translate"):
         from unicross.gaits import shipped_gaits
         gait = shipped_gaits(hand).get(f"{skill}_{axis}") if axis else None
+        beh = dict(oracle=_oracle, **(dict(gait=_gait(gait)) if gait else {}), zero=common["zero"],
+                   open=_finger_sweep(-0.02), close=_finger_sweep(0.02), random=common["random"])
         ref = PHYSICAL_REFERENCES.get((skill, axis))
-        extra = {ref[0]: _finger_sweep(ref[1], ref[2])} if ref and ref[0] not in ("open", "close") else {}
-        return dict(oracle=_oracle, **(dict(gait=_gait(gait)) if gait else {}), **extra, zero=common["zero"],
-                    open=_finger_sweep(-0.02), close=_finger_sweep(0.02), random=common["random"])
+        if ref:
+            beh.setdefault(ref[0], _finger_sweep(ref[1], ref[2]))
+        return beh
     raise ValueError(f"unknown skill {skill!r}; valid: grasp, relocate, rotate, translate")
 
 
