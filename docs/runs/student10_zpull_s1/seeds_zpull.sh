@@ -1,6 +1,6 @@
 #!/bin/bash
 # seeds 1 and 2 of the shipped student's recipe (teachers: the ten shipped checkpoints of 417c93f; code head 3858ec5)
-cd /work/main
+cd "$(dirname "$0")/../../.."  # the repository root
 for s in 1 2; do
   o=runs/student10_zpull_s$s
   E="--objects test --seed 0 --workers 2"

@@ -3,7 +3,11 @@
 Usage: python docs/runs/translate_zm_reference/scripted_pulls.py "SPEC|SPEC|..." LIMIT SEEDS
 SPEC: close=RATE (rad/step along the closing direction); fingers=0123 (index, middle, ring, thumb);
 joints=23 (joint positions within each finger); stop=M (hold once the object has moved M); cycle=UP:DOWN
-(close UP steps, reopen DOWN steps); wz=A or wz=rampA:B (wrist residual along the hand z)."""
+(close UP steps, reopen DOWN steps); wz=A or wz=rampA:B (wrist residual along the hand z).
+
+All behaviours of an object run in one env one after another, and PhysX state carries across resets,
+so a behaviour's numbers depend on the ones before it; finger_sequences.py scores behaviours as the
+evaluation does (a fresh env each) and is the one to compare with `unicross eval`."""
 import sys, torch, gymnasium as gym
 sys.path.insert(0, ".")
 import unicross  # noqa
