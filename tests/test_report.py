@@ -35,6 +35,15 @@ def test_report_paper_one_trial(tmp_path):
         trials = E.run_protocol("rotate", make_gait_policy(gaits[mode]), get_object_set("test", limit=1),
                                 trials_per_object=1, seed=0, progress=False, axes=[mode.split("_")[1]])
         assert f"| {mode} | gait:{gaits[mode]} | {_cell(E.summarize('rotate', trials), 'rotate')} |" in text
+    # each physical reference has its row on test and unseen objects, and a row is its evaluation
+    assert "## Physical references (scripted, not policies), held-out test objects" in text
+    assert "## Physical references (scripted, not policies), unseen objects" in text
+    trials = E.run_protocol("translate", E.make_reference_policy(), get_object_set("test", limit=1),
+                            trials_per_object=1, seed=0, progress=False, axes=["z-"])
+    row = (f"| translate_z- | reference (pull: the index finger's 2 distal joints at +0.05 rad per step) | "
+           f"{_cell(E.summarize('translate', trials), 'translate')} |")
+    assert row in text
+    assert "| translate_z+ | reference (open: every finger joint at -0.02 rad per step) | " in text
     # a cell is the evaluation itself: the zero-action relocation row equals an independent run
     trials = E.run_protocol("relocate", E.zero_policy, get_object_set("test", limit=1), trials_per_object=1,
                             seed=0, progress=False)

@@ -210,6 +210,8 @@ class PaperReport:
         if self.gaits:
             self.log("scripted gaits ...")
             lines += self._gait_tables()
+        self.log("physical references ...")
+        lines += self._reference_tables()
         self.log("baselines ...")
         base = [("relocate", "scripted-relocate", self.evaluate("relocate", "scripted-relocate", "test")),
                 ("relocate", "zero", self.evaluate("relocate", "zero", "test")),
@@ -243,6 +245,27 @@ class PaperReport:
                 "Rot. stays near the success angle by design (the paper's policies keep turning for 400 steps).")
             lines += self._rotate_pooled([(m, f"gait:{s}", objects, False) for m, s in self.gaits.items()],
                                          "a gait", setting)
+        return lines
+
+    def _reference_tables(self) -> List[str]:
+        """The physical reference of each mode that has one (:data:`unicross.audit.PHYSICAL_REFERENCES`,
+        ``--policy reference``) on test and unseen objects: the scripted bar beside its expert."""
+        from unicross.audit import PHYSICAL_REFERENCES
+        modes = [m for m in F.MODES if (skill_of_mode(m).name, mode_axis(m)) in PHYSICAL_REFERENCES]
+        lines = []
+        for objects, title, setting in (("test", "held-out test objects", "Experts"),
+                                        ("unseen", "unseen objects", "Uns.")):
+            rows = []
+            for mode in modes:
+                name, rate, joints = PHYSICAL_REFERENCES[(skill_of_mode(mode).name, mode_axis(mode))]
+                what = "every finger joint" if joints is None else f"the {joints[0]} finger's {joints[1]} distal joints"
+                rows.append((mode, f"reference ({name}: {what} at {rate:+g} rad per step)",
+                             self.evaluate(mode, "reference", objects)))
+            lines += self._table(
+                f"Physical references (scripted, not policies), {title}", rows, setting,
+                "A constant finger sweep that does the mode through contact alone (`--policy reference`; "
+                "translate z+ opens the fingers, z- curls the index finger): the scripted bar each translate "
+                "expert starts from (`model.init_reference`) and has to clear.")
         return lines
 
     def _rotate_pooled(self, cells: List[tuple], what: str, setting: str) -> List[str]:
