@@ -40,9 +40,10 @@ from unicross import formulation as F
 
 def _rollouts(gait: str, hand: str, objects: str, limit: int, trials: int, seed: int, randomize: bool,
               student, shard, beta: float = 0.0, privileged_q0: bool = False, clock: bool = False,
-              history: bool = False) -> tuple:
+              history: bool = False, sequence: str = None, mode: str = None) -> tuple:
     """One worker's share: (obs dict of [N, d], labels [N, A], trials) of the rotate protocol on its
-    objects, the gait acting (``student`` None) or the student's mean acting while the gait labels;
+    objects, the gait acting (``student`` None) or the student's mean acting while the gait labels
+    (with ``sequence``, a finger sequence of :mod:`unicross.sequences` on ``mode``'s protocol instead);
     with ``beta`` > 0 the gait's own action is taken instead at that fraction of the steps (each env
     and step drawn on its own: DAgger's mixture policy)."""
     torch.set_num_threads(1)
@@ -51,9 +52,14 @@ def _rollouts(gait: str, hand: str, objects: str, limit: int, trials: int, seed:
     from unicross.gaits import best_gait, gait_mode, gait_period, make_gait_policy, resolve_gait
     from unicross.objects import get_object_set
     from unicross.rl.env import split_obs
-    teacher = make_gait_policy(gait)
-    axis = gait_mode(teacher.gait_row).split("_")[1]
-    period = gait_period(best_gait(resolve_gait(gait))[0])
+    if sequence:
+        from unicross.sequences import make_sequence_policy
+        teacher, period = make_sequence_policy(sequence), None
+    else:
+        teacher = make_gait_policy(gait)
+        mode = gait_mode(teacher.gait_row)
+        period = gait_period(best_gait(resolve_gait(gait))[0])
+    skill, axis = mode.split("_")
     keys = ("hand", "object", "goal")
     rows = {k: [] for k in keys}
     labels = []
@@ -89,15 +95,19 @@ def _rollouts(gait: str, hand: str, objects: str, limit: int, trials: int, seed:
             act = torch.where(gait_steps, label, act)
         return act
 
-    out = E.run_protocol("rotate", policy, get_object_set(objects, limit=limit), hand=hand, trials_per_object=trials,
+    out = E.run_protocol(skill, policy, get_object_set(objects, limit=limit), hand=hand, trials_per_object=trials,
                          seed=seed, randomize=randomize, axes=[axis], progress=False, shard=shard)
     return {k: torch.cat(v) for k, v in rows.items()}, torch.cat(labels), out
 
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--gait", required=True, help="a shipped gait (allegro/rotate_y-) or a gait_search log, with "
-                    "options after commas (allegro/rotate_y-,tracking=phase,lookahead=1.5: unicross.gaits)")
+    teacher = ap.add_mutually_exclusive_group(required=True)
+    teacher.add_argument("--gait", help="a shipped gait (allegro/rotate_y-) or a gait_search log, with "
+                         "options after commas (allegro/rotate_y-,tracking=phase,lookahead=1.5: unicross.gaits)")
+    teacher.add_argument("--sequence", help="instead: a finger sequence (unicross.sequences), e.g. "
+                         "index:2:0.05:0:400+ring:2:0.05:@index:0.9, on the protocol of --mode")
+    ap.add_argument("--mode", default="translate_z-", help="the mode of --sequence (a gait names its own)")
     ap.add_argument("--hand", default="allegro")
     ap.add_argument("--objects", default="train")
     ap.add_argument("--limit", type=int, default=8, help="first N objects per group of --objects")
@@ -135,7 +145,16 @@ def main(argv=None) -> int:
     from unicross.rl.ppo import env_kwargs_for
     from unicross.rl.runner import git_commit
     from unicross import registry as R
-    mode = gait_mode(make_gait_policy(args.gait).gait_row)  # a bad gait or option fails before any simulation
+    if args.sequence:  # a bad sequence, mode, gait or option fails before any simulation
+        from unicross.sequences import parse_sequence
+        parse_sequence(args.sequence)
+        if args.mode not in F.MODES or "_" not in args.mode:
+            ap.error(f"--mode {args.mode!r}: an in-hand mode, one of {[m for m in F.MODES if '_' in m]}")
+        if args.clock:
+            ap.error("--clock needs a gait (its period)")
+        mode = args.mode
+    else:
+        mode = gait_mode(make_gait_policy(args.gait).gait_row)
     skill, axis = mode.split("_")
     cfg = load_config("ppo")
     if args.obs_std_min is not None:
@@ -163,7 +182,7 @@ def main(argv=None) -> int:
             parts = [f.result() for f in [ex.submit(_rollouts, args.gait, args.hand, args.objects, args.limit,
                                                      args.trials, args.seed + 7919 * r, args.randomize, student,
                                                      (i, args.workers), beta_of(r), args.privileged_q0,
-                                                     args.clock, args.history)
+                                                     args.clock, args.history, args.sequence, mode)
                                            for i in range(args.workers)]]
         o = {k: torch.cat([p[0][k] for p in parts]) for k in parts[0][0]}
         y = torch.cat([p[1] for p in parts])
@@ -228,7 +247,8 @@ def main(argv=None) -> int:
               skill=skill, axis=axis, hand=args.hand, env_id=R.skill(skill).env_id,
               env_kwargs=env_kwargs_for(skill, axis, args.hand, cfg["env"]), iteration=0,
               frames=sum(row.get("new_states", 0) for row in log),  # every control step simulated, all rounds
-              git_commit=git_commit(), commits=[git_commit()], clone_of=args.gait,
+              git_commit=git_commit(), commits=[git_commit()],
+              clone_of=args.gait or f"seq:{args.sequence}",
               wall_s=round(time.time() - t0, 1))
     diagnosis = args.privileged_q0 or args.clock or args.history
     if not diagnosis:

@@ -1,0 +1,54 @@
+"""Finger sequences (``unicross.sequences``): parsing, clock windows, per-env state triggers."""
+from types import SimpleNamespace
+
+import pytest
+import torch
+
+from robots.hand import load_hand
+from unicross.audit import finger_sweep_action
+from unicross.sequences import check_sequence, make_sequence_policy, parse_sequence
+
+
+def _env(n=3):
+    spec = load_hand("allegro")
+    return SimpleNamespace(hand_spec=spec, num_envs=n, device="cpu", elapsed_steps=torch.zeros(n, dtype=torch.int32),
+                           command=torch.zeros(n, spec.dof))
+
+
+@pytest.mark.parametrize("spec, msg", [("index:2:0.05:0", "finger:k:rate:t0:t1"),
+                                       ("index:two:0.05:0:10", "integers"),
+                                       ("index:0:0.05:0:10", ">= 1"),
+                                       ("index:2:0.05:@ring:high", "numbers")])
+def test_malformed_sequences_are_refused(spec, msg):
+    with pytest.raises(ValueError, match=msg):
+        parse_sequence(spec)
+
+
+def test_fingers_are_checked_against_the_hand():
+    spec = load_hand("allegro")
+    with pytest.raises(ValueError, match="no finger 'pinky'"):
+        check_sequence("pinky:2:0.05:0:10", spec)
+    with pytest.raises(ValueError, match="no finger 'pinky'"):
+        check_sequence("index:2:0.05:@pinky:0.9", spec)
+    with pytest.raises(ValueError, match="has 4 joints"):
+        check_sequence("index:5:0.05:0:10", spec)
+
+
+def test_clock_window_and_state_trigger_per_env():
+    u = _env()
+    policy = make_sequence_policy("index:2:0.05:0:2+ring:2:0.05:@index:0.9")
+    index = finger_sweep_action(u.hand_spec, 0.05, ("index", 2))
+    ring = finger_sweep_action(u.hand_spec, 0.05, ("ring", 2))
+    j = 6 + u.hand_spec.finger_joints.index(u.hand_spec.fingers["index"][-1])
+    assert torch.equal(policy(None, u), index.expand(3, -1))  # t = 0: the window, no trigger
+    u.elapsed_steps += 1
+    u.command[1, j] = 0.95  # env 1's index has reached theta
+    a = policy(None, u)
+    assert torch.equal(a[0], index) and torch.equal(a[1], (index + ring).clamp(-1, 1))
+    u.elapsed_steps += 1  # t = 2: the window has closed; env 1's trigger stays latched below theta
+    u.command[1, j] = 0.5
+    a = policy(None, u)
+    assert torch.equal(a[0], torch.zeros_like(index)) and torch.equal(a[1], ring)
+    u.elapsed_steps[1] = 0  # env 1 starts a new episode: its trigger clears
+    a = policy(None, u)
+    assert torch.equal(a[1], index) and torch.equal(a[2], torch.zeros_like(index))

@@ -1,0 +1,102 @@
+"""Finger sequences: scripted in-hand behaviours written as sums of one-finger sweeps.
+
+A sequence is a ``+``-joined list of terms ``finger:k:rate:START:END``: the ``k`` most distal joints of
+``finger`` move their targets ``rate`` rad per control step along the hand's closing direction
+(negative opens; :func:`unicross.audit.finger_sweep_action`), while the term is active:
+
+- ``finger:k:rate:t0:t1`` (integers): for control steps ``t0 <= t < t1`` of the episode (a clock,
+  which the observation does not show);
+- ``finger:k:rate:@other:theta``: from the first step at which the joint command of ``other``'s most
+  distal joint has reached ``theta`` rad, to the episode's end (a state trigger: the command is part
+  of the observation's s^h, so a network can represent the switch).
+
+Translate z- example (``docs/runs/translate_zm_reference/``): ``index:2:0.05:0:400+ring:2:0.05:@index:0.9``
+curls the index finger's two distal joints (the shipped physical reference) and, once the index's
+distal command has reached 0.9 rad, the ring finger's too. Per-env batched: each env has its own
+clock and trigger.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import List, Optional
+
+import torch
+
+
+@dataclass(frozen=True)
+class Sweep:
+    finger: str
+    k: int
+    rate: float
+    t0: int = 0                    # clock window [t0, t1) (used when ``trigger`` is None)
+    t1: int = 0
+    trigger: Optional[str] = None  # finger whose most distal command starts the sweep
+    theta: float = 0.0             # ... once it has reached theta rad
+
+
+def parse_sequence(spec: str) -> List[Sweep]:
+    """The sweeps of ``spec``; a malformed spec raises ``ValueError`` saying which term and why."""
+    sweeps = []
+    for term in spec.split("+"):
+        parts = term.split(":")
+        if len(parts) != 5:
+            raise ValueError(f"sequence term {term!r}: write finger:k:rate:t0:t1 or finger:k:rate:@finger:theta")
+        finger, k, rate, start, end = parts
+        try:
+            k_, rate_ = int(k), float(rate)
+            if start.startswith("@"):
+                sweeps.append(Sweep(finger, k_, rate_, trigger=start[1:], theta=float(end)))
+            else:
+                sweeps.append(Sweep(finger, k_, rate_, t0=int(start), t1=int(end)))
+        except ValueError:
+            raise ValueError(f"sequence term {term!r}: k and the window must be integers, rate and theta "
+                             f"numbers") from None
+        if k_ < 1:
+            raise ValueError(f"sequence term {term!r}: k (joints moved) must be >= 1")
+    return sweeps
+
+
+def check_sequence(spec: str, hand_spec) -> List[Sweep]:
+    """:func:`parse_sequence`, with the fingers and joint counts checked against ``hand_spec``."""
+    sweeps = parse_sequence(spec)
+    for s in sweeps:
+        for f in (s.finger, s.trigger):
+            if f is not None and f not in hand_spec.fingers:
+                raise ValueError(f"sequence {spec!r}: hand {hand_spec.name!r} has no finger {f!r}; "
+                                 f"its fingers: {list(hand_spec.fingers)}")
+        if s.k > len(hand_spec.fingers[s.finger]):
+            raise ValueError(f"sequence {spec!r}: finger {s.finger!r} has {len(hand_spec.fingers[s.finger])} joints, "
+                             f"not {s.k}")
+    return sweeps
+
+
+def make_sequence_policy(spec: str):
+    """A policy ``(obs, env) -> action [n, dof]`` that sums the sweeps of ``spec`` active at each env's
+    control step (see the module docstring); triggers latch per env and clear at its step 0."""
+    from unicross.audit import finger_sweep_action
+    parse_sequence(spec)  # a malformed spec fails before any simulation
+    cache = {}
+
+    def policy(obs, u) -> torch.Tensor:
+        if cache.get("env") is not u:
+            sweeps = check_sequence(spec, u.hand_spec)
+            terms = []
+            for s in sweeps:
+                a = finger_sweep_action(u.hand_spec, s.rate, (s.finger, s.k)).to(u.device)
+                j = (6 + u.hand_spec.finger_joints.index(u.hand_spec.fingers[s.trigger][-1])) if s.trigger else None
+                terms.append((a, s, j))
+            cache.update(env=u, terms=terms,
+                         on=torch.zeros(u.num_envs, len(terms), dtype=torch.bool, device=u.device))
+        t = u.elapsed_steps.to(u.device)[:, None]  # [n, 1]: the control step about to be taken
+        on = cache["on"]
+        on &= t != 0  # a new episode clears its triggers
+        a = torch.zeros(u.num_envs, u.hand_spec.dof, device=u.device)
+        for i, (sweep, s, j) in enumerate(cache["terms"]):
+            if j is None:
+                active = (t >= s.t0) & (t < s.t1)
+            else:
+                on[:, i] |= u.command[:, j] >= s.theta
+                active = on[:, i:i + 1]
+            a = a + sweep * active
+        return a.clamp(-1.0, 1.0)
+    return policy
