@@ -22,6 +22,13 @@ and a PPO run can start from it (``unicross train ... --set model.init_policy=OU
 
     python benchmarks/gait_clone.py --gait allegro/rotate_y- --limit 8 --trials 2 --rounds 5 \
         --out docs/runs/gait_clone/rotate_y-
+
+``--sequence SPEC --mode MODE`` clones a finger sequence (:mod:`unicross.sequences`) on MODE's protocol
+the same way; a sequence whose terms are state-triggered is a function of the observation (up to the
+clock windows it uses), e.g. translate z-'s index pull with the ring finger joining once the index has curled:
+
+    python benchmarks/gait_clone.py --sequence "index:2:0.05:0:1000+ring:2:0.05:@index:0.9" --mode translate_z- \
+        --limit 8 --trials 2 --rounds 4 --out docs/runs/translate_zm_reference/clone_ring
 """
 from __future__ import annotations
 
