@@ -9,6 +9,12 @@ the student's own training episodes:
 
     python benchmarks/plot_curves.py runs/student_s0 --out docs/student_curves.png
 
+Clones of scripted behaviours (``benchmarks/gait_clone.py``, its ``log.jsonl``) are drawn as the success
+of each DAgger round's rollouts (round 0: the teacher) with its 95% Wilson interval, and the network's
+action error on each round's new states before it was fitted to them, against the states gathered:
+
+    python benchmarks/plot_curves.py runs/clone_s0 runs/clone_s1 --out docs/clone_curves.png
+
 Needs matplotlib (``pip install matplotlib``).
 """
 from __future__ import annotations
@@ -45,6 +51,8 @@ def main(argv=None) -> int:
     import matplotlib.pyplot as plt
     fig, (a, b) = plt.subplots(1, 2, figsize=(11, 4))
     runs = list(map(Path, args.runs))
+    if all(is_clone(r) for r in runs):
+        return plot_clone(runs, fig, a, b, args)
     if all(is_dagger(r) for r in runs):
         return plot_dagger(runs, fig, a, b, args)
     for run in runs:
@@ -75,6 +83,34 @@ def save(fig, args, rect=(0, 0, 1, 1)) -> int:
     fig.savefig(args.out, dpi=110)
     print(f"wrote {args.out}")
     return 0
+
+
+def is_clone(run: Path) -> bool:
+    return (run / "log.jsonl").exists() and not (run / "metrics.jsonl").exists()
+
+
+def plot_clone(runs, fig, a, b, args) -> int:
+    """Per run: the success of each round's rollouts (Wilson 95%) and the fresh action error."""
+    from unicross.metrics import wilson_interval
+    for run in runs:
+        rows = [r for r in (json.loads(line) for line in (run / "log.jsonl").read_text().splitlines() if line.strip())
+                if "round" in r]
+        x = [sum(q["new_states"] for q in rows[:i + 1]) for i in range(len(rows))]
+        k = [round(r["success"] * r["episodes"]) for r in rows]
+        ci = [wilson_interval(kk, r["episodes"]) for kk, r in zip(k, rows)]
+        line, = a.plot(x, [100 * r["success"] for r in rows], marker="o", ms=3,
+                       label=f"{run.name} (n={rows[0]['episodes']} per round)")
+        a.fill_between(x, [100 * lo for lo, _ in ci], [100 * hi for _, hi in ci], color=line.get_color(), alpha=0.12)
+        pts = [(xx, r["fresh_mse"]) for xx, r in zip(x, rows) if "fresh_mse" in r]
+        b.plot([p_[0] for p_ in pts], [p_[1] for p_ in pts], marker="o", ms=3, color=line.get_color(), label=run.name)
+    a.set(xlabel="states gathered (control steps)", ylabel="success (%)", ylim=(-2, 102),
+          title="rollouts per DAgger round (round 0: the teacher; 95% CI)")
+    b.set(xlabel="states gathered (control steps)", ylabel="action MSE", yscale="log",
+          title="network's error on each round's new states")
+    for ax in (a, b):
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8)
+    return save(fig, args)
 
 
 def is_dagger(run: Path) -> bool:
