@@ -52,3 +52,36 @@ def test_clock_window_and_state_trigger_per_env():
     u.elapsed_steps[1] = 0  # env 1 starts a new episode: its trigger clears
     a = policy(None, u)
     assert torch.equal(a[1], index) and torch.equal(a[2], torch.zeros_like(index))
+
+
+def test_eval_cli_runs_a_sequence_as_run_protocol_does(tmp_path):
+    """``unicross eval --policy seq:SPEC`` (worker processes resolve the spec) gives the trials of the
+    sequence policy run in-process, as docs/runs/translate_zm_reference/finger_sequences.py runs it."""
+    import json
+
+    from unicross import evaluation as E
+    from unicross.cli import main
+    from unicross.objects import get_object_set
+    spec = "index:2:0.05:0:1000+ring:2:0.05:@index:0.9"
+    out = tmp_path / "e.json"
+    assert main(["eval", "--policy", f"seq:{spec}", "--protocol", "translate", "--axis", "z-", "--objects", "test",
+                 "--limit", "1", "--trials-per-object", "1", "--out", str(out)]) == 0
+    d = json.loads(out.read_text())
+    assert d["policy"] == dict(kind="sequence", sequence=spec)
+    trials = E.run_protocol("translate", make_sequence_policy(spec), get_object_set("test", limit=1),
+                            trials_per_object=1, seed=0, axes=["z-"], progress=False)
+    assert d["trials"]["translate"] == json.loads(json.dumps(trials))
+
+
+def test_eval_cli_refuses_a_bad_sequence_before_simulation(tmp_path, capsys):
+    from unicross.cli import main
+    assert main(["eval", "--policy", "seq:pinky:2:0.05:0:10", "--protocol", "translate", "--axis", "z-",
+                 "--out", str(tmp_path / "e.json")]) == 2
+    assert "no finger 'pinky'" in capsys.readouterr().err
+    assert not (tmp_path / "e.json").exists()
+
+
+def test_report_names_what_a_clone_copied():
+    from unicross.report import how_trained
+    assert how_trained({"clone_of": "seq:index:2:0.05:0:10", "config": {}}).startswith("DAgger clone of seq:index:2:")
+    assert how_trained({"clone_of": "allegro/rotate_y-", "config": {}}).startswith("DAgger clone of gait:allegro/rotate_y-")

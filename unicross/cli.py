@@ -539,7 +539,8 @@ def main(argv=None) -> int:
     s = sub.add_parser("eval", help="run the paper's evaluation protocols; writes JSON (every trial) and a table")
     s.add_argument("--policy", required=True,
                    help="checkpoint path, or zero | random | scripted-grasp | scripted-relocate | reference[@FRACTION] "
-                        "(the physical reference: translate z+ opens the fingers, z- curls the index) | gait:LOG or gait:allegro/rotate_y- (the best finger gait "
+                        "(the physical reference: translate z+ opens the fingers, z- curls the index) | seq:SPEC (a finger sequence, "
+                        "unicross.sequences, e.g. seq:index:2:0.05:0:1000+ring:2:0.05:@index:0.9) | gait:LOG or gait:allegro/rotate_y- (the best finger gait "
                         "of a benchmarks/gait_search.py log, or a shipped one, run until the mode is done, then holding)")
     s.add_argument("--protocol", default="all", help="grasp, relocate, rotate, translate (comma list) or all")
     s.add_argument("--objects", default="test", help="object set: train | test | unseen (| -wrappable/-elongated | mesh:<file>)")

@@ -153,6 +153,12 @@ def resolve_policy(spec: str, hand: str, seed: int = 0):
         return scripted_relocate_policy, dict(kind="scripted-relocate")
     if spec == "scripted-grasp":
         return make_scripted_grasp_policy(), dict(kind="scripted-grasp")
+    if spec.startswith("seq:"):
+        from unicross.robots.hand import load_hand
+        from unicross.sequences import check_sequence, make_sequence_policy
+        seq = spec[len("seq:"):]
+        check_sequence(seq, load_hand(hand))  # a malformed sequence or a finger the hand lacks fails here
+        return make_sequence_policy(seq), dict(kind="sequence", sequence=seq)
     if spec.startswith("gait:"):
         from unicross.gaits import make_gait_policy
         path = spec[len("gait:"):]

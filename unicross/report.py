@@ -52,6 +52,11 @@ def _gait_origin(ck: dict):
     return ("clone", ck["clone_of"]) if ck.get("clone_of") else None
 
 
+def _scripted(clone_of: str) -> str:
+    """The ``--policy`` spec of what a clone copied: a finger sequence (``seq:...``) or a gait."""
+    return clone_of if clone_of.startswith("seq:") else f"gait:{clone_of}"
+
+
 def policy_label(spec: str) -> str:
     """A checkpoint's name in the tables, saying so when it acts on top of a scripted gait or is a
     network cloned from one rather than a PPO expert."""
@@ -60,7 +65,7 @@ def policy_label(spec: str) -> str:
     if origin is None:
         return spec
     how, gait = origin
-    return f"{spec} (PPO on top of gait:{gait})" if how == "residual" else f"{spec} (DAgger clone of gait:{gait}, not PPO)"
+    return f"{spec} (PPO on top of gait:{gait})" if how == "residual" else f"{spec} (DAgger clone of {_scripted(gait)}, not PPO)"
 
 
 def how_trained(ck: dict) -> str:
@@ -71,7 +76,7 @@ def how_trained(ck: dict) -> str:
     origin = _gait_origin(ck)
     if origin is not None:
         how, gait = origin
-        return f"PPO on top of gait:{gait}" if how == "residual" else f"DAgger clone of gait:{gait} (its search not counted)"
+        return f"PPO on top of gait:{gait}" if how == "residual" else f"DAgger clone of {_scripted(gait)} (its search not counted)"
     init = (ck.get("config") or {}).get("model", {}).get("init_reference")
     return f"PPO from a scripted start (model.init_reference {init:g})" if init else "PPO"
 
