@@ -48,8 +48,8 @@ from unicross import formulation as F
 def _rollouts(gait: str, hand: str, objects: str, limit: int, trials: int, seed: int, randomize: bool,
               student, shard, beta: float = 0.0, privileged_q0: bool = False, clock: bool = False,
               history: bool = False, sequence: str = None, mode: str = None) -> tuple:
-    """One worker's share: (obs dict of [N, d], labels [N, A], trials) of the rotate protocol on its
-    objects, the gait acting (``student`` None) or the student's mean acting while the gait labels
+    """One worker's share: (obs dict of [N, d], labels [N, A], trials) of the protocol of the gait's mode
+    on its objects, the gait acting (``student`` None) or the student's mean acting while the gait labels
     (with ``sequence``, a finger sequence of :mod:`unicross.sequences` on ``mode``'s protocol instead);
     with ``beta`` > 0 the gait's own action is taken instead at that fraction of the steps (each env
     and step drawn on its own: DAgger's mixture policy)."""
