@@ -1,6 +1,7 @@
 #!/bin/bash
-# the nine held-out evaluations of the candidate student (teachers: the shipped ten with translate z- the sequence clone)
-o=runs/student10_zring_s0
+# the nine held-out evaluations of a student distilled from the shipped ten (translate z- the sequence clone);
+# usage: bash eval_student_zring.sh [RUN_DIR]   (default runs/student10_zring_s0; seeds 1-2: runs/student10_zring_s1, _s2)
+o=${1:-runs/student10_zring_s0}
 P=$o/checkpoint.pt
 E="--objects test --seed 0 --workers 2"
 unicross eval --policy $P --protocol translate --axis z- $E --limit 20 --trials-per-object 3 --out $o/eval_translate_z-_test120.json >> $o.eval.log 2>&1
