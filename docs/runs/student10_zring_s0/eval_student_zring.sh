@@ -1,6 +1,7 @@
 #!/bin/bash
-# the nine held-out evaluations of a student distilled from the shipped ten (translate z- the sequence clone);
-# usage: bash eval_student_zring.sh [RUN_DIR]   (default runs/student10_zring_s0; seeds 1-2: runs/student10_zring_s1, _s2)
+# the nine held-out evaluations of any student run (unicross distill --out RUN_DIR), written into RUN_DIR;
+# usage: bash eval_student_zring.sh [RUN_DIR]   (default runs/student10_zring_s0; used for runs/student10_zring_s{0,1,2}
+# (translate z- teacher: the ring clone) and runs/student10_relay_s0 (the relay clone, the shipped student))
 o=${1:-runs/student10_zring_s0}
 P=$o/checkpoint.pt
 E="--objects test --seed 0 --workers 2"
