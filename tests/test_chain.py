@@ -91,7 +91,7 @@ def test_chain_state_round_trip_keeps_the_phase():
     """The phase and phase successes are task state: restoring a state taken in the second phase
     after the episode moved on to the third brings the phase and mode back."""
     env = make("UniCross-Chain-v1", objects="test-wrappable", sequence="grasp,relocate,rotate:y-",
-               phase_steps=dict(grasp=3, relocate=3, rotate=3), randomize=False)
+               phase_steps=dict(grasp=3, relocate=3, rotate=3), randomize=False, obs_mode="state_dict")
     u = env.unwrapped
     env.reset(seed=1)
     for _ in range(4):
@@ -114,3 +114,39 @@ def test_last_phase_by_mode_splits_a_sequence_kind_by_its_in_hand_mode():
                                   t("translate_z+", False)])
     assert list(s) == ["translate_z+", "translate_z-"]
     assert (s["translate_z+"]["n"], s["translate_z+"]["successes"]) == (3, 2) and s["translate_z-"]["sr"] == 0.0
+
+
+def test_experts_policy_acts_with_the_expert_of_each_phase(tmp_path):
+    """``experts:allegro`` (or a distill-style folder) switches expert at each phase boundary: every
+    action is the current mode's shipped expert's; a wrong folder fails before any simulation."""
+    from unicross.evaluation import resolve_policy
+    fn, desc = resolve_policy("experts:allegro", "allegro")
+    assert desc["kind"] == "experts" and desc["experts"]["rotate_y-"] == "allegro/rotate_y-"
+    single = {m: resolve_policy(f"allegro/{m}", "allegro")[0] for m in ("grasp", "relocate", "rotate_y-")}
+    env = make("UniCross-Chain-v1", objects="test-wrappable", sequence="grasp,relocate,rotate:y-",
+               phase_steps=dict(grasp=3, relocate=3, rotate=3), randomize=False, obs_mode="state_dict")
+    u = env.unwrapped
+    obs, _ = u.reset(seed=1)
+    seen = []
+    try:
+        for _ in range(8):
+            m = F.MODES[u.mode.item()]
+            seen.append(m)
+            a = fn(obs, u)
+            torch.testing.assert_close(a, single[m](obs, u))
+            assert all((a - single[o](obs, u)).abs().max() > 1e-4 for o in single if o != m)
+            obs, *_ = u.step(a)
+    finally:
+        env.close()
+    assert seen == ["grasp"] * 3 + ["relocate"] * 3 + ["rotate_y-"] * 2
+    with pytest.raises(FileNotFoundError, match="neither a folder"):
+        resolve_policy(f"experts:{tmp_path / 'none'}", "allegro")
+    with pytest.raises(FileNotFoundError, match="no expert checkpoint"):
+        resolve_policy(f"experts:{tmp_path}", "allegro")
+    import shutil
+    from unicross.rl.policy_io import SHIPPED_DIR
+    for m in F.MODES:  # every folder holds the grasp expert: the wrong mode is named
+        (tmp_path / m).mkdir()
+        shutil.copy(SHIPPED_DIR / "allegro" / "grasp.pt", tmp_path / m / "checkpoint.pt")
+    with pytest.raises(ValueError, match="trained for mode 'grasp', not 'relocate'"):
+        resolve_policy(f"experts:{tmp_path}", "allegro")

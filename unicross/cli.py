@@ -541,7 +541,9 @@ def main(argv=None) -> int:
                    help="checkpoint path, or zero | random | scripted-grasp | scripted-relocate | reference[@FRACTION] "
                         "(the physical reference: translate z+ opens the fingers, z- curls the index) | seq:SPEC (a finger sequence, "
                         "unicross.sequences, e.g. seq:index:2:0.05:0:1000+ring:2:0.05:@index:0.9) | gait:LOG or gait:allegro/rotate_y- (the best finger gait "
-                        "of a benchmarks/gait_search.py log, or a shipped one, run until the mode is done, then holding)")
+                        "of a benchmarks/gait_search.py log, or a shipped one, run until the mode is done, then holding) | "
+                        "experts:DIR or experts:allegro (one expert per mode, DIR/<mode>/checkpoint.pt as distill reads them "
+                        "or the hand's shipped ones, each env acted on by its mode's expert)")
     s.add_argument("--protocol", default="all", help="grasp, relocate, rotate, translate (comma list) or all")
     s.add_argument("--objects", default="test", help="object set: train | test | unseen (| -wrappable/-elongated | mesh:<file>)")
     s.add_argument("--limit", type=positive, default=None, help="first N objects per (category, type) group")
@@ -602,7 +604,8 @@ def main(argv=None) -> int:
     s.add_argument("--resume", action="store_true")
     s.set_defaults(fn=_cmd_distill)
     s = sub.add_parser("chain", help="long-horizon skill chaining with one policy; prints per-phase outcomes")
-    s.add_argument("--policy", required=True, help="student/expert checkpoint, or zero | random")
+    s.add_argument("--policy", required=True, help="student/expert checkpoint, zero | random, or experts:DIR | experts:allegro "
+                        "(the per-mode experts, switched at each phase: the teachers' chain)")
     s.add_argument("--sequence", default=None,
                    help="e.g. grasp,relocate,rotate:x+ (default: the paper's protocol, random in-hand axis)")
     s.add_argument("--objects", default="test")

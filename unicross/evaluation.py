@@ -128,6 +128,46 @@ def make_reference_policy(fraction: float = 1.0) -> PolicyFn:
     return policy
 
 
+def expert_specs(source: str, hand: str) -> Dict[str, str]:
+    """mode -> checkpoint of one expert per mode: ``source`` a folder laid out as ``unicross distill
+    --experts`` reads it (``<mode>/checkpoint.pt``), or a hand's name for its shipped checkpoints."""
+    from unicross.rl.policy_io import SHIPPED_DIR
+    if source == hand:
+        missing = [m for m in F.MODES if not (SHIPPED_DIR / hand / f"{m}.pt").exists()]
+        if missing:
+            raise FileNotFoundError(f"policy experts:{hand}: no shipped checkpoint for mode(s) {missing} "
+                                    f"under {SHIPPED_DIR / hand}")
+        return {m: f"{hand}/{m}" for m in F.MODES}
+    from pathlib import Path
+    if not Path(source).is_dir():
+        raise FileNotFoundError(f"policy experts:{source}: neither a folder of <mode>/checkpoint.pt nor the hand "
+                                f"{hand!r} (experts:{hand} takes its shipped checkpoints)")
+    from unicross.rl.dagger import expert_paths
+    return {m: str(p) for m, p in expert_paths(source).items()}
+
+
+def make_experts_policy(source: str, hand: str, seed: int = 0) -> Tuple[PolicyFn, dict]:
+    """The per-mode experts as one policy: each env is acted on by the expert of its current mode
+    (the task's ``mode``, which the goal's one-hot shows the networks), so a long-horizon chain
+    switches expert at each phase boundary: the teachers' side of the student's chain."""
+    specs = expert_specs(source, hand)
+    loaded = {m: resolve_policy(s, hand, seed) for m, s in specs.items()}  # each checked against the hand
+    for m, (_, desc) in loaded.items():
+        trained = R.skill(desc["skill"]).mode(desc.get("axis")) if desc.get("skill") in R.SKILLS else desc.get("skill")
+        if trained != m:
+            raise ValueError(f"policy experts:{source}: {specs[m]} was trained for mode {trained!r}, not {m!r}")
+    policies = {F.MODES.index(m): fn for m, (fn, _) in loaded.items()}
+
+    def policy(obs, u):
+        mode = u.mode
+        out = None
+        for i in torch.unique(mode).tolist():
+            a = policies[i](obs, u)
+            out = a if out is None else torch.where((mode == i)[:, None], a, out)
+        return out
+    return policy, dict(kind="experts", source=source, experts=specs)
+
+
 def reference_fraction(spec: str) -> Optional[float]:
     """``reference`` -> 1.0, ``reference@0.75`` -> 0.75, anything else -> None."""
     if spec != "reference" and not spec.startswith("reference@"):
@@ -159,6 +199,8 @@ def resolve_policy(spec: str, hand: str, seed: int = 0):
         seq = spec[len("seq:"):]
         check_sequence(seq, load_hand(hand))  # a malformed sequence or a finger the hand lacks fails here
         return make_sequence_policy(seq), dict(kind="sequence", sequence=seq)
+    if spec.startswith("experts:"):
+        return make_experts_policy(spec[len("experts:"):], hand, seed)
     if spec.startswith("gait:"):
         from unicross.gaits import make_gait_policy
         path = spec[len("gait:"):]
