@@ -17,6 +17,13 @@ def test_report_paper_one_trial(tmp_path):
                   "Disturbances", "Baselines", "Training budget of the shipped checkpoints", "Long horizon"):
         assert f"## {title}" in text
     assert "In-hand phase by mode: " in text
+    if all(m in shipped("allegro") for m in E.F.MODES) and "student" in shipped("allegro"):  # the teachers' long horizon on the same trials
+        lh = text.split("## Long horizon", 1)[1]
+        assert "`unicross chain --policy experts:allegro`" in lh
+        trials = E.run_chain(E.make_experts_policy("allegro", "allegro")[0], get_object_set("test", limit=1),
+                             trials_per_object=1, seed=0, progress=False)
+        experts_part = lh.split("experts:allegro", 1)[1]
+        assert E.chain_table(E.summarize_chain(trials)) in experts_part
     n_test = len(get_object_set("test", limit=1))
     ships = shipped("allegro")
     for mode in ("grasp", "relocate"):

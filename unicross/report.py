@@ -289,20 +289,34 @@ class PaperReport:
                 f"the experts: >= 50% averaged over the six axes (paper {PAPER[setting]['rotate'][0]:.1f}).", ""]
 
     def _long_horizon(self) -> List[str]:
-        from unicross.evaluation import (chain_last_phase_by_mode, chain_table, run_chain, summarize_chain,
-                                         resolve_policy, sr_cell)
-        policy, _ = resolve_policy(self.ckpts["student"], self.hand)
+        """The student's long horizon, then the same trials with the experts switched at each phase
+        (``--policy experts:<hand>``): the teachers' side of the same cells."""
+        from unicross.evaluation import make_experts_policy, resolve_policy
+        missing = [m for m in F.MODES if m not in self.student_modes]
+        note = ([f"The student was distilled for {', '.join(self.student_modes)} only (not for "
+                 f"{', '.join(missing)}): phases of those modes are not expected to succeed.", ""] if missing else [])
+        lines = note + self._chain(resolve_policy(self.ckpts["student"], self.hand)[0])
+        lines += [f"The experts, each phase acted on by its mode's shipped expert (`unicross chain --policy "
+                  f"experts:{self.hand}`), on the same trials: what the student's teachers do chained.", ""]
+        no_expert = [m for m in F.MODES if m not in self.ckpts]
+        if no_expert:
+            lines += [f"Not run: no shipped expert for {', '.join(no_expert)}.", ""]
+        else:
+            self.log("long horizon, the experts ...")
+            lines += self._chain(make_experts_policy(self.hand, self.hand, self.seed)[0])
+        return lines + ["Paper (its student): " + "; ".join(f"{k} {' / '.join(f'{x:g}' for x in v)}"
+                                                            for k, v in PAPER["long"].items()), ""]
+
+    def _chain(self, policy) -> List[str]:
+        """The paper's long-horizon protocol with ``policy``: per-phase table and the in-hand phase by mode."""
+        from unicross.evaluation import chain_last_phase_by_mode, chain_table, run_chain, summarize_chain, sr_cell
         objs = get_object_set("test", limit=self.limit)
         # the paper's sequences split the objects: wrappable ones rotate, elongated ones translate
         per_sequence = min(sum(o.category == c for o in objs) for c in {o.category for o in objs})
         trials = run_chain(policy, objs, hand=self.hand, trials_per_object=self.trials_per_object(per_sequence),
                            seed=self.seed, progress=False)
-        missing = [m for m in F.MODES if m not in self.student_modes]
-        note = ([f"The student was distilled for {', '.join(self.student_modes)} only (not for "
-                 f"{', '.join(missing)}): phases of those modes are not expected to succeed.", ""] if missing else [])
         by_mode = "; ".join(f"{m} {sr_cell(v)}" for m, v in chain_last_phase_by_mode(trials).items())
-        return note + [chain_table(summarize_chain(trials)), "", f"In-hand phase by mode: {by_mode}.", "",
-                "Paper: " + "; ".join(f"{k} {' / '.join(f'{x:g}' for x in v)}" for k, v in PAPER["long"].items()), ""]
+        return [chain_table(summarize_chain(trials)), "", f"In-hand phase by mode: {by_mode}.", ""]
 
 
 def paper_report(out: str, argv: List[str], **kwargs) -> str:
