@@ -91,7 +91,7 @@ def test_chain_state_round_trip_keeps_the_phase():
     """The phase and phase successes are task state: restoring a state taken in the second phase
     after the episode moved on to the third brings the phase and mode back."""
     env = make("UniCross-Chain-v1", objects="test-wrappable", sequence="grasp,relocate,rotate:y-",
-               phase_steps=dict(grasp=3, relocate=3, rotate=3), randomize=False, obs_mode="state_dict")
+               phase_steps=dict(grasp=3, relocate=3, rotate=3), randomize=False)
     u = env.unwrapped
     env.reset(seed=1)
     for _ in range(4):
