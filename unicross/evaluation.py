@@ -29,6 +29,7 @@ passed, then holding: :mod:`unicross.gaits`). Same seed and policy give identica
 from __future__ import annotations
 
 import logging
+from pathlib import Path
 from typing import Callable, Dict, List, Optional, Sequence, Tuple
 
 import gymnasium as gym
@@ -138,7 +139,6 @@ def expert_specs(source: str, hand: str) -> Dict[str, str]:
             raise FileNotFoundError(f"policy experts:{hand}: no shipped checkpoint for mode(s) {missing} "
                                     f"under {SHIPPED_DIR / hand}")
         return {m: f"{hand}/{m}" for m in F.MODES}
-    from pathlib import Path
     if not Path(source).is_dir():
         raise FileNotFoundError(f"policy experts:{source}: neither a folder of <mode>/checkpoint.pt nor the hand "
                                 f"{hand!r} (experts:{hand} takes its shipped checkpoints)")
@@ -153,7 +153,7 @@ def make_experts_policy(source: str, hand: str, seed: int = 0) -> Tuple[PolicyFn
     specs = expert_specs(source, hand)
     loaded = {m: resolve_policy(s, hand, seed) for m, s in specs.items()}  # each checked against the hand
     for m, (_, desc) in loaded.items():
-        trained = R.skill(desc["skill"]).mode(desc.get("axis")) if desc.get("skill") in R.SKILLS else desc.get("skill")
+        trained = R.trained_mode(desc.get("skill"), desc.get("axis"))
         if trained != m:
             raise ValueError(f"policy experts:{source}: {specs[m]} was trained for mode {trained!r}, not {m!r}")
     policies = {F.MODES.index(m): fn for m, (fn, _) in loaded.items()}
@@ -375,7 +375,6 @@ def run_protocol_workers(protocol: str, spec: str, objects: Sequence[ObjectSpec]
 
 
 def _save_video(rec, video_dir, name: str) -> None:
-    from pathlib import Path
     from unicross.render import RenderUnavailable, render
     d = Path(video_dir or ".")
     traj = rec.save(d / f"{name}.npz")

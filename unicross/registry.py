@@ -129,3 +129,9 @@ def mode_axis(mode: str) -> Optional[str]:
     """The axis of a mode name (None for axis-free modes)."""
     _, _, axis = mode.partition("_")
     return axis or None
+
+
+def trained_mode(skill_name: Optional[str], axis: Optional[str] = None) -> Optional[str]:
+    """The mode a checkpoint was trained for from its ``skill``/``axis`` fields; a skill name outside
+    the registry (e.g. a student's ``multi``) is returned as it is."""
+    return skill(skill_name).mode(axis) if skill_name in SKILLS else skill_name

@@ -57,7 +57,7 @@ class Teachers(torch.nn.Module):
             if base_policy_of(ck) is not None:
                 raise ValueError(f"expert {p} acts on top of the gait {base_policy_of(ck)} (model.base_policy): "
                                  "DAgger distils experts that are networks alone")
-            trained = R.skill(ck["skill"]).mode(ck.get("axis")) if ck.get("skill") in R.SKILLS else ck.get("skill")
+            trained = R.trained_mode(ck.get("skill"), ck.get("axis"))
             if trained != m:
                 raise ValueError(f"expert {p} was trained for mode {trained!r}, not {m!r}: each mode's folder "
                                  f"needs that mode's expert")
