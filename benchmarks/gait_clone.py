@@ -47,12 +47,13 @@ from unicross import formulation as F
 
 def _rollouts(gait: str, hand: str, objects: str, limit: int, trials: int, seed: int, randomize: bool,
               student, shard, beta: float = 0.0, privileged_q0: bool = False, clock: bool = False,
-              history: bool = False, sequence: str = None, mode: str = None) -> tuple:
+              history: bool = False, sequence: str = None, mode: str = None, grasps: str = None) -> tuple:
     """One worker's share: (obs dict of [N, d], labels [N, A], trials) of the protocol of the gait's mode
     on its objects, the gait acting (``student`` None) or the student's mean acting while the gait labels
     (with ``sequence``, a finger sequence of :mod:`unicross.sequences` on ``mode``'s protocol instead);
     with ``beta`` > 0 the gait's own action is taken instead at that fraction of the steps (each env
-    and step drawn on its own: DAgger's mixture policy)."""
+    and step drawn on its own: DAgger's mixture policy). ``grasps``: the grasp-state dataset the episodes
+    start from (None: the hand's shipped one)."""
     torch.set_num_threads(1)
     import unicross  # noqa: F401  (registers the tasks)
     from unicross import evaluation as E
@@ -103,7 +104,8 @@ def _rollouts(gait: str, hand: str, objects: str, limit: int, trials: int, seed:
         return act
 
     out = E.run_protocol(skill, policy, get_object_set(objects, limit=limit), hand=hand, trials_per_object=trials,
-                         seed=seed, randomize=randomize, axes=[axis], progress=False, shard=shard)
+                         seed=seed, randomize=randomize, axes=[axis], progress=False, shard=shard,
+                         grasp_dataset=grasps)
     return {k: torch.cat(v) for k, v in rows.items()}, torch.cat(labels), out
 
 
@@ -140,6 +142,7 @@ def main(argv=None) -> int:
                          "and command), as HORA's proprioceptive history; its checkpoint does not fit the UniCross "
                          "observation and is not written")
     ap.add_argument("--randomize", action="store_true", help="training's randomisation (default: the evaluation's conditions)")
+    ap.add_argument("--grasps", default=None, help="grasp-state dataset the episodes start from (default: the shipped one)")
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--out", required=True)
@@ -168,6 +171,10 @@ def main(argv=None) -> int:
         if args.obs_std_min < 0:
             ap.error("--obs-std-min must be >= 0")
         cfg["model"]["obs_std_min"] = args.obs_std_min
+    if args.grasps is not None:
+        if not Path(args.grasps).is_file():
+            ap.error(f"--grasps {args.grasps}: no such file")
+        cfg["env"]["grasp_dataset"] = args.grasps
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     torch.manual_seed(args.seed)
@@ -189,7 +196,7 @@ def main(argv=None) -> int:
             parts = [f.result() for f in [ex.submit(_rollouts, args.gait, args.hand, args.objects, args.limit,
                                                      args.trials, args.seed + 7919 * r, args.randomize, student,
                                                      (i, args.workers), beta_of(r), args.privileged_q0,
-                                                     args.clock, args.history, args.sequence, mode)
+                                                     args.clock, args.history, args.sequence, mode, args.grasps)
                                            for i in range(args.workers)]]
         o = {k: torch.cat([p[0][k] for p in parts]) for k in parts[0][0]}
         y = torch.cat([p[1] for p in parts])

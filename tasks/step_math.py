@@ -149,7 +149,8 @@ class StepMath:
                     speed_cap=self._speed_cap[self.mode], relational=cur, reward_targets=reward_targets,
                     finger_qpos=m["qpos"][:, 6:], finger_qpos0=self.finger_q0, hand_lin_vel=self.hand_vel,
                     hand_ang_vel=self.hand_angvel, finger_torque=m["finger_torque"], drop=drop, held=held, success=success,
-                    goal_err_prev=goal_err_prev, goal_err=goal_err, success_paid=self.success_paid)
+                    goal_err_prev=goal_err_prev, goal_err=goal_err, success_paid=self.success_paid,
+                    obj_speed_hand=self.obj_vel_h.norm(dim=-1), obj_angspeed_hand=self.obj_angvel_h.norm(dim=-1))
         terms = self.rewards(self.mode, meas)
         self.success_paid = torch.where(pend, self.success_paid + terms["success"], self.success_paid)
         self._observation_parts(m, cur, contact, force_c)

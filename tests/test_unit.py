@@ -114,7 +114,8 @@ def measurements(n: int, L: int = 5, seed: int = 0) -> dict:
                 finger_qpos0=torch.randn(n, 16, generator=g), hand_lin_vel=torch.randn(n, 3, generator=g),
                 hand_ang_vel=torch.randn(n, 3, generator=g), finger_torque=torch.randn(n, 16, generator=g),
                 drop=torch.rand(n, generator=g) > 0.8, held=torch.ones(n, dtype=torch.bool),
-                success_paid=torch.rand(n, generator=g) * 50)
+                success_paid=torch.rand(n, generator=g) * 50, obj_speed_hand=torch.rand(n, generator=g),
+                obj_angspeed_hand=torch.rand(n, generator=g))
 
 
 def test_every_registered_term_is_computed_finite_and_per_env():
@@ -187,6 +188,18 @@ def test_progress_term_telescopes_to_the_error_reduction():
     assert torch.allclose(total, expect, atol=1e-6)
 
 
+def test_settle_term_charges_the_speed_in_the_hand_only_while_the_success_holds():
+    """In units of the dataset's settle test, the larger of the two ratios, capped; 0 by default (the paper's)."""
+    cfg = load_config("reward", {"settle": {"weight": {"grasp": 2.0}}})
+    c = RW.RewardTerms(cfg, "cpu").coefficients("settle")
+    assert float(RW.RewardTerms(load_config("reward"), "cpu").coefficients("settle")["w"].abs().sum()) == 0.0
+    m = dict(obj_speed_hand=torch.tensor([0.1, 0.01, 1.0, 0.1, 0.1]),
+             obj_angspeed_hand=torch.tensor([0.1, 1.5, 0.0, 0.1, 0.1]),
+             success=torch.tensor([True, True, True, False, True]))
+    mode = torch.tensor([F.MODES.index("grasp")] * 4 + [F.MODES.index("relocate")])
+    assert torch.allclose(RW.settle_reward(m, c, mode), torch.tensor([-4.0, -6.0, -10.0, 0.0, 0.0]))
+
+
 def test_frozen_config_refuses_writes_and_copies_are_plain():
     import copy
     import pickle
@@ -218,3 +231,17 @@ def test_the_wrist_can_start_with_its_own_exploration_noise():
     assert head.log_std[:6].tolist() == [-1.0] * 6 and head.log_std[6:].tolist() == [-4.0] * 16
     head = make_models(dims, 22, None, dict(init_log_std=-2.0))[0].module[0].module
     assert head.log_std.tolist() == [-2.0] * 22
+
+
+def test_training_reads_another_grasp_dataset_only_for_in_hand_skills(tmp_path):
+    """env.grasp_dataset reaches the in-hand tasks' constructor; a missing file is refused before any
+    simulation; the grasp skill (starts on the table) ignores it."""
+    from unicross.rl.ppo import env_kwargs_for
+    env = dict(load_config("ppo")["env"])
+    assert "grasp_dataset" not in env_kwargs_for("translate", "z+", "allegro", env)
+    env["grasp_dataset"] = str(tmp_path / "none.pt")
+    with pytest.raises(FileNotFoundError, match="env.grasp_dataset"):
+        env_kwargs_for("translate", "z+", "allegro", env)
+    assert "grasp_dataset" not in env_kwargs_for("grasp", None, "allegro", env)
+    (tmp_path / "none.pt").write_bytes(b"")
+    assert env_kwargs_for("relocate", None, "allegro", env)["grasp_dataset"] == str(tmp_path / "none.pt")

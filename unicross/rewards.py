@@ -3,7 +3,8 @@
 ``r = r_goal + r_track + r_reg`` with
   r_goal  = contact + motion (+ success: ours, a per-step bonus while the mode's success holds;
             + progress: ours, the decrease of the object's error to its final pose (relocate);
-            both 0 in the paper, see configs/reward.yaml)
+            + settle: ours, the object's speed in the hand while the success holds;
+            all 0 in the paper, see configs/reward.yaml)
   r_track = Σ w · error over the six relational poses (position errors saturate at ``track.max_pos_error``)
   r_reg   = pose + wrist_velocity + energy + drop
 
@@ -99,6 +100,19 @@ def success_reward(m: dict, c: dict, mode: torch.Tensor) -> torch.Tensor:
     that passes the threshold and then drops it nets no bonus."""
     first_drop = (m["drop"] & m["held"]).float()
     return c["w"][mode] * m["success"].float() - c["revoke"][mode] * m["success_paid"] * first_drop
+
+
+@reward_term("settle", lambda cfg, dev: dict(w=per_mode(cfg["settle"]["weight"], dev),
+                                             speed=float(cfg["settle"]["speed"]),
+                                             angular_speed=float(cfg["settle"]["angular_speed"]),
+                                             cap=float(cfg["settle"]["cap"])))
+def settle_reward(m: dict, c: dict, mode: torch.Tensor) -> torch.Tensor:
+    """-w · min(max(||v_o^h|| / speed, ||ω_o^h|| / angular_speed), cap) while the mode's success
+    holds: the object's speed in the hand frame, in units of the grasp-state dataset's settle test
+    (a grasp is kept when both ratios are below 1), so a success with the object still slipping or
+    rolling in the hand earns less than a firm one (ours; paper: none)."""
+    s = torch.maximum(m["obj_speed_hand"] / c["speed"], m["obj_angspeed_hand"] / c["angular_speed"])
+    return -c["w"][mode] * s.clamp(max=c["cap"]) * m["success"].float()
 
 
 @reward_term("progress", lambda cfg, dev: dict(w_pos=per_mode(cfg["progress"], dev, "w_pos"),

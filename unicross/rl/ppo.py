@@ -15,6 +15,7 @@ from __future__ import annotations
 import json
 import math
 import time
+from pathlib import Path
 from typing import Optional
 
 import torch
@@ -63,6 +64,11 @@ def env_kwargs_for(skill: str, axis: Optional[str], hand: str, env_cfg: dict) ->
         kw["objects"] = env_cfg["objects"]
     if env_cfg.get("object_limit") is not None:
         kw["object_limit"] = env_cfg["object_limit"]
+    if env_cfg.get("grasp_dataset") and not R.skill(skill).starts_on_table:
+        if not Path(env_cfg["grasp_dataset"]).is_file():
+            raise FileNotFoundError(f"env.grasp_dataset={env_cfg['grasp_dataset']}: no such file "
+                                    "(build one with `unicross grasps --expert ... --out FILE`)")
+        kw["grasp_dataset"] = str(env_cfg["grasp_dataset"])
     return kw
 
 

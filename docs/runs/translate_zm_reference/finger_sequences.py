@@ -7,7 +7,9 @@ SPEC: a finger sequence (`unicross.sequences`): '+'-joined terms finger:k:rate:t
 thumb; its k most distal joints; rate rad per control step along the closing direction, negative opens; active for
 t0 <= t < t1) or finger:k:rate:@other:theta (active once the command of `other`'s most distal joint has reached
 theta rad: a state trigger, which the observation shows, where the time is not).
-OBJECTS: an object set (train, test, unseen), LIMIT objects per group, TRIALS per object."""
+OBJECTS: an object set (train, test, unseen), LIMIT objects per group, TRIALS per object. The episodes start from the
+shipped grasp-state dataset, or from the file UNICROSS_GRASPS names."""
+import os
 import sys
 
 import torch
@@ -25,7 +27,7 @@ def main() -> None:
     objs = get_object_set(sys.argv[2], limit=int(sys.argv[3]))
     for spec in specs:
         trials = E.run_protocol("translate", make_sequence_policy(spec), objs, trials_per_object=int(sys.argv[4]), seed=0,
-                                axes=["z-"], progress=False)
+                                axes=["z-"], progress=False, grasp_dataset=os.environ.get("UNICROSS_GRASPS"))
         n, ok = len(trials), sum(t["success"] for t in trials)
         drops = sum(t["dropped"] for t in trials)
         print(f"{spec:70s} success {ok}/{n} ({100 * ok / n:.1f}%), drops {drops}", flush=True)
