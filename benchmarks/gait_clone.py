@@ -151,6 +151,7 @@ def main(argv=None) -> int:
     import unicross  # noqa: F401
     from unicross.config import load_config
     from unicross.gaits import gait_mode, make_gait_policy
+    from unicross.grasps import grasp_dataset_file
     from unicross.rl.models import make_models
     from unicross.rl.ppo import env_kwargs_for
     from unicross.rl.runner import git_commit
@@ -172,9 +173,7 @@ def main(argv=None) -> int:
             ap.error("--obs-std-min must be >= 0")
         cfg["model"]["obs_std_min"] = args.obs_std_min
     if args.grasps is not None:
-        if not Path(args.grasps).is_file():
-            ap.error(f"--grasps {args.grasps}: no such file")
-        cfg["env"]["grasp_dataset"] = args.grasps
+        cfg["env"]["grasp_dataset"] = grasp_dataset_file(args.grasps, "--grasps")
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     torch.manual_seed(args.seed)

@@ -52,6 +52,10 @@ def test_refuses_to_start_without_every_expert(tmp_path, experts):
         (fake / m / "checkpoint.pt").symlink_to(src)
     with pytest.raises(ValueError, match="trained for mode 'grasp', not 'rotate_x\\+'"):
         DAggerTrainer(tmp_path / "run2", fake, progress=False)
+    # another grasp-state dataset for the in-hand modes' starts must exist (refused before any worker starts)
+    with pytest.raises(FileNotFoundError, match="env.grasp_dataset"):
+        DAggerTrainer(tmp_path / "run3", experts, overrides=dict(env=dict(grasp_dataset=str(tmp_path / "none.pt"))),
+                      progress=False)
 
 
 def test_tiny_dagger_lowers_action_mse_on_every_mode(tmp_path, experts):

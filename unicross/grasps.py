@@ -50,6 +50,14 @@ def from_rows(hand: str, object_names: Sequence[str], rows: Dict[str, list], tri
     return GraspSet(hand, list(object_names), data, source=source), stats
 
 
+def grasp_dataset_file(path, what: str = "env.grasp_dataset") -> str:
+    """``path`` as a string once it names an existing file (training configs: refused before any
+    simulation starts, with how to build one)."""
+    if not Path(path).is_file():
+        raise FileNotFoundError(f"{what}={path}: no such file (build one with `unicross grasps --expert ... --out FILE`)")
+    return str(path)
+
+
 def default_grasp_path(hand: str) -> Path:
     """The grasp dataset shipped with the project for ``hand`` (``configs/grasps/<hand>.pt``)."""
     return CONFIG_DIR / "grasps" / f"{hand}.pt"

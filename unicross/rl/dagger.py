@@ -28,6 +28,7 @@ from tqdm import tqdm
 
 from unicross import formulation as F
 from unicross import registry as R
+from unicross.grasps import grasp_dataset_file
 from unicross.rl.collector import check_overlap, make_collector, resolve_num_envs
 from unicross.rl.models import OBS_KEYS, make_models
 from unicross.rl.policy_io import base_policy_of, load_policy
@@ -113,6 +114,8 @@ class DAggerTrainer(Runner):
             kw["objects"] = ec["objects"]
         if ec.get("object_limit") is not None:
             kw["object_limit"] = ec["object_limit"]
+        if ec.get("grasp_dataset"):
+            kw["grasp_dataset"] = grasp_dataset_file(ec["grasp_dataset"])
         self.device = torch.device("cuda" if ec["backend"] == "physx_cuda" else "cpu")
         self.share_cores(ec["backend"])
         self.teachers = Teachers(paths, self.device)

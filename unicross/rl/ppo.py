@@ -15,7 +15,6 @@ from __future__ import annotations
 import json
 import math
 import time
-from pathlib import Path
 from typing import Optional
 
 import torch
@@ -24,6 +23,7 @@ from tqdm import tqdm
 
 from unicross import formulation as F
 from unicross import registry as R
+from unicross.grasps import grasp_dataset_file
 from unicross.rewards import term_names
 from unicross.rl.algorithm import PPO
 from unicross.rl.collector import check_overlap, check_teacher, make_collector, resolve_num_envs
@@ -65,10 +65,7 @@ def env_kwargs_for(skill: str, axis: Optional[str], hand: str, env_cfg: dict) ->
     if env_cfg.get("object_limit") is not None:
         kw["object_limit"] = env_cfg["object_limit"]
     if env_cfg.get("grasp_dataset") and not R.skill(skill).starts_on_table:
-        if not Path(env_cfg["grasp_dataset"]).is_file():
-            raise FileNotFoundError(f"env.grasp_dataset={env_cfg['grasp_dataset']}: no such file "
-                                    "(build one with `unicross grasps --expert ... --out FILE`)")
-        kw["grasp_dataset"] = str(env_cfg["grasp_dataset"])
+        kw["grasp_dataset"] = grasp_dataset_file(env_cfg["grasp_dataset"])
     return kw
 
 
