@@ -71,3 +71,15 @@ def test_resume_continues_exactly_and_records_every_segment(tmp_path):
 def test_resume_needs_a_checkpoint(tmp_path):
     with pytest.raises(FileNotFoundError, match="no checkpoint"):
         Counter(tmp_path / "none", resume=True)
+
+
+def test_a_resumed_csv_keeps_its_columns_when_the_fields_grow(tmp_path):
+    """A run resumed under a version with a new reward term: metrics.csv keeps its header, every row
+    lines up with it (the new column goes to metrics.jsonl only)."""
+    import csv
+    run = Counter(tmp_path / "r")
+    run.append_csv("metrics.csv", dict(epoch=1, a=1.0, b=2.0), ["epoch", "a", "b"])
+    run.append_csv("metrics.csv", dict(epoch=2, a=3.0, new=9.0, b=4.0), ["epoch", "a", "new", "b"])
+    with open(tmp_path / "r" / "metrics.csv", newline="") as f:
+        rows = list(csv.reader(f))
+    assert rows == [["epoch", "a", "b"], ["1", "1.0", "2.0"], ["2", "3.0", "4.0"]]

@@ -262,6 +262,9 @@ class Runner:
         self.run_dir.mkdir(parents=True, exist_ok=True)
         path = self.run_dir / name
         new = not path.exists()
+        if not new:  # a run resumed under a newer version keeps its file's columns (a new reward term: jsonl only)
+            with open(path, newline="") as f:
+                fields = next(csv.reader(f), None) or fields
         with open(path, "a", newline="") as f:
             w = csv.DictWriter(f, fieldnames=fields, extrasaction="ignore")
             if new:
