@@ -19,6 +19,12 @@ from unicross.rl.policy_io import act, load_policy
 from unicross.scripted_grasp import grasp_state
 
 
+def settled_in_hand(u, settle_speed: float = 0.05):
+    """[N] bool: the object moves in the hand frame slower than ``settle_speed`` (m/s) and ten times
+    that in rad/s over the last control step (the test a kept grasp passes)."""
+    return (u.obj_vel_h.norm(dim=-1) < settle_speed) & (u.obj_angvel_h.norm(dim=-1) < 10 * settle_speed)
+
+
 def expert_grasps(ckpt_path, objects: Sequence[ObjectSpec], per_object: int, seed: int = 0,
                   max_tries: int | None = None, settle_speed: float = 0.05, progress: bool = True):
     import unicross  # noqa: F401
@@ -44,8 +50,7 @@ def expert_grasps(ckpt_path, objects: Sequence[ObjectSpec], per_object: int, see
                 if bool(term.all()):
                     break
             tried[obj.name] += 1
-            settled = (u.obj_vel_h.norm(dim=-1) < settle_speed) & (u.obj_angvel_h.norm(dim=-1) < 10 * settle_speed)
-            ok = info["success"] & ~info["ever_dropped"] & settled
+            ok = info["success"] & ~info["ever_dropped"] & settled_in_hand(u, settle_speed)
             if bool(ok[0]):
                 for k, v in grasp_state(u, 0, oi).items():
                     rows[k].append(v)

@@ -9,6 +9,7 @@ import gymnasium as gym
 import unicross  # noqa: F401
 from unicross import evaluation as E
 from unicross.objects import get_object_set
+from unicross.rl.expert_grasps import settled_in_hand
 from unicross.seeding import trial_seed
 
 p = argparse.ArgumentParser()
@@ -30,7 +31,7 @@ for oi, obj in enumerate(get_object_set(a.objects, limit=a.limit)):
                 break
         v, w = float(u.obj_vel_h.norm(dim=-1)[0]), float(u.obj_angvel_h.norm(dim=-1)[0])
         ok = bool(info["success"][0]) and not bool(info["ever_dropped"][0])
-        rows.append(dict(object=obj.name, trial=t, success=ok, speed=v, angspeed=w, settled=ok and v < 0.05 and w < 0.5))
+        rows.append(dict(object=obj.name, trial=t, success=ok, speed=v, angspeed=w, settled=ok and bool(settled_in_hand(u)[0])))
     env.close()
 groups = {}
 for r in rows:
