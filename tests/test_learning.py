@@ -367,6 +367,32 @@ def test_init_policy_starts_the_actor_from_a_policy_checkpoint(tmp_path):
         PPOTrainer(tmp_path / "rot", "rotate", "x+", overrides=over, progress=False)
 
 
+def test_init_policy_brings_its_input_floor(tmp_path):
+    """A policy trained with an input floor (``model.obs_std_min``: the shipped rotate clones) starts a
+    PPO run as itself: the run adopts the floor, whatever its configuration said, and acts as the
+    loaded policy on inputs near its statistics (where a floor of 0 divides by ~1e-4 instead of 0.01).
+    Fails without the adoption: the run kept its configured floor and started from another policy."""
+    from unicross.rl.policy_io import load_policy, resolve_checkpoint
+    from unicross.rl.ppo import PPOTrainer
+    shipped = str(resolve_checkpoint("allegro/rotate_y-"))
+    ref, ck = load_policy(shipped)
+    assert ck["config"]["model"]["obs_std_min"] == 0.01  # the premise: the shipped clone has a floor
+    over = dict(env=dict(num_envs=1, object_limit=1), collector=dict(total_frames=16, horizon=16),
+                model=dict(init_policy=shipped, obs_std_min=0.0), logging=dict(eval_trials=0, final_eval_trials=0))
+    t = PPOTrainer(tmp_path / "ry", "rotate", "y-", overrides=over, progress=False)
+    try:
+        assert t.algo.norm.std_min == 0.01 and t.cfg["model"]["obs_std_min"] == 0.01
+        g = torch.Generator().manual_seed(0)
+        norm = ref.module[0].module.net.norm
+        x = [getattr(norm, f"{k}_mean") + 0.01 * torch.randn(4, ck["obs_dims"][k], generator=g)
+             for k in ("hand", "object", "goal")]
+        want, _ = ref.module[0].module(*x)
+        got, _ = t.algo.actor(*x)
+        torch.testing.assert_close(got, want)
+    finally:
+        t.close()
+
+
 @pytest.mark.slow
 def test_gait_clone_writes_a_policy_that_loads_and_logs_its_fresh_error(tmp_path):
     """benchmarks/gait_clone.py end to end at its smallest (one object per group, one round): a

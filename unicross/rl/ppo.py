@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import json
 import math
+import sys
 import time
 from typing import Optional
 
@@ -88,6 +89,18 @@ def policy_to_start_from(path, skill: str, axis: Optional[str], hand: str, base_
     return ck
 
 
+def adopt_input_floor(model_cfg: dict, ck: dict) -> None:
+    """The run's ``model.obs_std_min`` becomes the one ``ck`` (the ``model.init_policy`` checkpoint) was
+    trained with: the floor of the std its inputs are divided by is part of that policy (the
+    normaliser's statistics come with its weights, the floor is configuration), so a run started
+    from it under another floor would start from another policy. Says so when it changes the value."""
+    floor = float(((ck.get("config") or {}).get("model") or {}).get("obs_std_min") or 0.0)
+    if float(model_cfg.get("obs_std_min") or 0.0) != floor:
+        print(f"[unicross] model.obs_std_min={floor}: the input floor model.init_policy was trained with "
+              f"(the run's configuration had {model_cfg.get('obs_std_min')})", file=sys.stderr, flush=True)
+        model_cfg["obs_std_min"] = floor
+
+
 def evaluation_shard(actor, skill: str, objects: str, limit, trials_per_object: int, seed: int, hand: str,
                      axis: Optional[str], ablation: Optional[dict], shard, base_policy: Optional[str] = None) -> list:
     """One worker's share of a held-out evaluation (see :meth:`PPOTrainer._protocol`)."""
@@ -131,6 +144,7 @@ class PPOTrainer(Runner):
         if self.ckpt is None and cfg["model"].get("init_policy"):  # refused before any simulation
             start_policy = policy_to_start_from(cfg["model"]["init_policy"], skill, axis, hand,
                                                 cfg["model"].get("base_policy"))
+            adopt_input_floor(cfg["model"], start_policy)
         if self.ckpt is None and cfg["model"].get("init_reference") is not None:
             from unicross.audit import reference_action
             start_mean = reference_action(skill, axis, spec, float(cfg["model"]["init_reference"]))
