@@ -245,3 +245,32 @@ def test_training_reads_another_grasp_dataset_only_for_in_hand_skills(tmp_path):
     assert "grasp_dataset" not in env_kwargs_for("grasp", None, "allegro", env)
     (tmp_path / "none.pt").write_bytes(b"")
     assert env_kwargs_for("relocate", None, "allegro", env)["grasp_dataset"] == str(tmp_path / "none.pt")
+
+
+@pytest.mark.parametrize("once", [True, False])
+def test_training_log_counts_an_episode_success_as_the_protocol_does(once):
+    """PPO's logged success per finished episode: for a ``success_once`` skill (rotate, translate) the
+    success held at some step and nothing dropped, carried across batches; otherwise the flag at the
+    episode's last step. Two envs, two batches of 3 steps: env 0 passes the threshold in batch 1 and
+    slides back before its episode ends in batch 2; env 1 passes it and then drops (its success flag
+    turns false at the drop)."""
+    from types import SimpleNamespace
+    from tensordict import TensorDict
+    from unicross.rl.ppo import PPOTrainer
+
+    def batch(succ, drop, done):
+        t = lambda v, dt: torch.tensor(v, dtype=dt)[..., None]  # noqa: E731  [envs, T, 1]
+        return TensorDict({"next": {"reward": torch.ones(2, 3, 1), "done": t(done, torch.bool),
+                                    "info": {"success": t(succ, torch.bool), "drop": t(drop, torch.bool)}}},
+                          batch_size=[2, 3])
+    z = lambda dt: torch.zeros(2, 1, dtype=dt)  # noqa: E731
+    me = SimpleNamespace(_success_once=once, _ep_return=z(torch.float32), _ep_reached=z(torch.bool),
+                         _ep_dropped=z(torch.bool))
+    first = PPOTrainer._episode_stats(me, batch([[0, 1, 0], [0, 1, 0]], [[0, 0, 0], [0, 0, 1]],
+                                                [[0, 0, 0], [0, 0, 0]]))
+    assert first["episodes"] == 0
+    second = PPOTrainer._episode_stats(me, batch([[0, 0, 0], [0, 0, 0]], [[0, 0, 0], [0, 0, 0]],
+                                                 [[0, 1, 0], [0, 1, 0]]))
+    assert second["episodes"] == 2 and second["episode_return"] == 5.0
+    assert second["success_rate"] == (0.5 if once else 0.0)
+    assert not me._ep_reached.any() and not me._ep_dropped.any()  # reset with the episodes

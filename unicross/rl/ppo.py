@@ -201,6 +201,11 @@ class PPOTrainer(Runner):
         # after loading: the workers share these weights (overlap: a copy of them, synced per batch)
         self.collector.set_actor(self.algo.actor, own_copy=self.overlap)
         self._ep_return = torch.zeros(num_envs, 1, device=self.device)
+        # the episode's success as the skill's protocol counts it (``Skill.success_once``: reached at any
+        # step, never dropped; else at its last step), over the training episode
+        self._success_once = R.skill(self.skill).success_once
+        self._ep_reached = torch.zeros(num_envs, 1, dtype=torch.bool, device=self.device)
+        self._ep_dropped = torch.zeros(num_envs, 1, dtype=torch.bool, device=self.device)
 
     # ------------------------------------------------------------------ state
     # the algorithm's parts, for inspection
@@ -255,19 +260,28 @@ class PPOTrainer(Runner):
 
     # ------------------------------------------------------------------ training
     def _episode_stats(self, data: TensorDict) -> dict:
-        """Returns/successes of episodes that ended in this batch (data: [..., T])."""
+        """Returns and successes of the episodes that ended in this batch (data: [..., T]). An episode's
+        success is the protocol's rule over the training episode: for a ``success_once`` skill (rotate,
+        translate) the success test held at some step and the object was never dropped (the per-step
+        flag of its last step misses the turns and pushes that pass the threshold and slide back);
+        otherwise the flag at its last step."""
         rew = data["next", "reward"]
         done = data["next", "done"]
         succ = data["next", "info", "success"]
-        ret = self._ep_return
+        drop = data["next", "info", "drop"]
+        ret, reached, dropped = self._ep_return, self._ep_reached, self._ep_dropped
         finished_r, finished_s = [], []
         for t in range(rew.shape[-2]):
             ret = ret + rew[..., t, :]
+            reached = reached | succ[..., t, :]
+            dropped = dropped | drop[..., t, :]
             d = done[..., t, :]
+            ok = reached & ~dropped if self._success_once else succ[..., t, :]
             finished_r.append(ret[d])
-            finished_s.append(succ[..., t, :][d].float())
+            finished_s.append(ok[d].float())
             ret = torch.where(d, torch.zeros_like(ret), ret)
-        self._ep_return = ret
+            reached, dropped = reached & ~d, dropped & ~d
+        self._ep_return, self._ep_reached, self._ep_dropped = ret, reached, dropped
         r, s = torch.cat(finished_r), torch.cat(finished_s)
         out = {"episodes": int(r.numel())}
         if r.numel():
