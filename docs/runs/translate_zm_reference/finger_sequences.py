@@ -30,7 +30,11 @@ def main() -> None:
                                 axes=["z-"], progress=False, grasp_dataset=os.environ.get("UNICROSS_GRASPS"))
         n, ok = len(trials), sum(t["success"] for t in trials)
         drops = sum(t["dropped"] for t in trials)
-        print(f"{spec:70s} success {ok}/{n} ({100 * ok / n:.1f}%), drops {drops}", flush=True)
+        by_shape = {}
+        for t in trials:  # object names are CATEGORY-SHAPE-SET-INDEX
+            by_shape.setdefault(t["object"].split("-")[1], []).append(t["success"])
+        shapes = ", ".join(f"{k} {sum(v)}/{len(v)}" for k, v in sorted(by_shape.items()))
+        print(f"{spec:70s} success {ok}/{n} ({100 * ok / n:.1f}%), drops {drops}; {shapes}", flush=True)
 
 
 if __name__ == "__main__":
