@@ -127,3 +127,22 @@ def test_teacher_term_pulls_the_mean_to_the_teacher_and_decays():
     mean0, _, out0 = run(0.0)
     assert out0["loss_teacher"] == 0.0
     assert (mean0 - target).abs().max() > 0.15
+
+
+@pytest.mark.parametrize("mode, init_policy, frozen", [(None, None, False), (None, "allegro/rotate_y-", True),
+                                                      ("running", "allegro/rotate_y-", False), ("frozen", None, True)])
+def test_observation_statistics_freeze_with_a_copied_policy(mode, init_policy, frozen):
+    """``model.obs_stats``: running statistics fold every batch in; frozen ones stay as the first batch
+    (or ``model.init_policy``) left them, so a copied policy keeps its input scaling; null freezes them
+    exactly when the run starts from a policy. A bad value is refused."""
+    cfg = load_config("ppo", {"model": {"obs_stats": mode, "init_policy": init_policy}})
+    torch.manual_seed(0)
+    algo = PPO(DIMS, A, cfg, frames_per_batch=N * T)
+    g = torch.Generator().manual_seed(1)
+    algo.update(bandit_batch(algo, g))  # the first batch fits the statistics either way
+    after_first = {k: v.clone() for k, v in algo.norm.state_dict().items()}
+    algo.update(bandit_batch(algo, g))
+    same = all(torch.equal(after_first[k], v) for k, v in algo.norm.state_dict().items())
+    assert same == frozen
+    with pytest.raises(ValueError, match="model.obs_stats"):
+        PPO(DIMS, A, load_config("ppo", {"model": {"obs_stats": "fixed"}}), frames_per_batch=N * T)

@@ -28,6 +28,16 @@ LOSS_KEYS = ("loss_objective", "loss_critic", "entropy", "kl_approx", "clip_frac
              "explained_variance", "value_clip_fraction", "loss_teacher")
 
 
+def obs_stats_frozen(model_cfg: dict) -> bool:
+    """Whether the observation statistics stay fixed once they exist (``model.obs_stats``): "frozen",
+    "running" (folded in from every collected batch), or null: frozen when the run starts from
+    ``model.init_policy``, whose statistics are part of the policy it copies, running otherwise."""
+    mode = model_cfg.get("obs_stats")
+    if mode not in (None, "running", "frozen"):
+        raise ValueError(f"model.obs_stats must be 'running', 'frozen' or null, not {mode!r}")
+    return mode == "frozen" or (mode is None and bool(model_cfg.get("init_policy")))
+
+
 class PPO:
     """PPO for one policy (``cfg``: the ``model``, ``loss``, ``gae`` and ``optim`` sections of
     ``configs/ppo.yaml``) on observations of sizes ``dims`` with ``n_act`` actions in [-1, 1];
@@ -40,6 +50,7 @@ class PPO:
         if oc["schedule"] not in ("fixed", "adaptive"):
             raise ValueError(f"optim.schedule must be 'fixed' or 'adaptive', not {oc['schedule']!r}")
         self.policy, self.value, self.norm = make_models(dims, n_act, Bounded(-1.0, 1.0, (n_act,)), cfg["model"])
+        self.frozen_stats = obs_stats_frozen(cfg["model"])
         self.policy.to(device)
         self.value.to(device)
         lc = cfg["loss"]
@@ -137,7 +148,7 @@ class PPO:
                 if kl_stop is not None and klv > kl_stop:  # the policy moved far enough for this batch
                     stopped = True
                     break
-        if not fitted_first:
+        if not (fitted_first or self.frozen_stats):
             self.norm.update({k: flat[k] for k in OBS_KEYS})
         out = {k: v / count for k, v in stats.items()}
         out["kl"] = out.pop("kl_approx")

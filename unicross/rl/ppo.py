@@ -26,7 +26,7 @@ from unicross import formulation as F
 from unicross import registry as R
 from unicross.grasps import grasp_dataset_file
 from unicross.rewards import term_names
-from unicross.rl.algorithm import PPO
+from unicross.rl.algorithm import PPO, obs_stats_frozen
 from unicross.rl.collector import check_overlap, check_teacher, make_collector, resolve_num_envs
 from unicross.rl.models import OBS_KEYS  # noqa: F401  (re-exported for benchmarks)
 from unicross.rl.runner import CKPT_NAME, Runner, atomic_save, git_commit, open_run  # noqa: F401  (re-exported)
@@ -145,6 +145,7 @@ class PPOTrainer(Runner):
             start_policy = policy_to_start_from(cfg["model"]["init_policy"], skill, axis, hand,
                                                 cfg["model"].get("base_policy"))
             adopt_input_floor(cfg["model"], start_policy)
+        obs_stats_frozen(cfg["model"])  # a bad model.obs_stats is refused before any simulation
         if self.ckpt is None and cfg["model"].get("init_reference") is not None:
             from unicross.audit import reference_action
             start_mean = reference_action(skill, axis, spec, float(cfg["model"]["init_reference"]))
