@@ -95,7 +95,10 @@ class UniCrossEnv(TaskScene, EpisodeStarts, StepMath, TaskStateIO, BaseEnv):
                  objects=None, object_limit: Optional[int] = None,
                  modes: Optional[Sequence[str]] = None, grasp_dataset: Optional[str] = None,
                  config: Optional[dict] = None, reward_config: Optional[dict] = None,
-                 randomize: Optional[bool] = None, robot_uids=None, **kwargs):
+                 randomize: Optional[bool] = None, compile_math: Optional[bool] = None, robot_uids=None,
+                 **kwargs):
+        # compile_math: compile the step math (None: the UNICROSS_COMPILE switch). False for an env that
+        # never steps (the SAPIEN renderer's replay), which would otherwise compile it at its first reset.
         # ---- validate everything before any simulation starts
         backend = str(kwargs.get("sim_backend", "auto")).split(":")[0]
         gpu = backend in ("gpu", "cuda", "physx_cuda") or (backend == "auto" and int(kwargs.get("num_envs", 1)) > 1)
@@ -106,9 +109,9 @@ class UniCrossEnv(TaskScene, EpisodeStarts, StepMath, TaskStateIO, BaseEnv):
             raise ValueError(f"UniCross tasks have one control mode, 'pd_joint_pos' (normalised residual joint "
                              f"targets, see formulation.map_action), not {kwargs['control_mode']!r}: pass "
                              f"control_mode='pd_joint_pos' (ManiSkill's PPO baseline: --control_mode pd_joint_pos)")
-        self._compiled = compile_enabled()  # UNICROSS_COMPILE (unicross/compiling.py), read once per env
-        self._step_math = compile_method(self, self._step_math_eager, cpu=not gpu)
-        self._command_math = compile_method(self, self._command_math_eager, cpu=not gpu)
+        self._compiled = compile_enabled() if compile_math is None else bool(compile_math)  # read once per env
+        self._step_math = compile_method(self, self._step_math_eager, cpu=not gpu, enabled=self._compiled)
+        self._command_math = compile_method(self, self._command_math_eager, cpu=not gpu, enabled=self._compiled)
         self.hand_spec: HandSpec = load_hand(hand)
         if hand_overrides:
             import dataclasses

@@ -21,6 +21,21 @@ def test_switch(monkeypatch):
     assert torch.equal(g(x), x + 1) and torch.equal(g(x), x + 1)
 
 
+def test_an_env_can_opt_out_of_the_switch(monkeypatch, grasp_file):
+    """``compile_math=False`` keeps an env's step math eager with the switch on (the SAPIEN
+    renderer's replay env only resets: compiling there cost a minute on a lent machine), and
+    ``compile_math=True`` compiles it with the switch off."""
+    monkeypatch.setenv("UNICROSS_COMPILE", "1")
+    u = make("UniCross-Grasp-v1", grasp_file, compile_math=False).unwrapped
+    assert not u._compiled and not isinstance(u._step_math, GraphMethod)
+    assert u._step_math == u._step_math_eager and u._command_math == u._command_math_eager
+    monkeypatch.setenv("UNICROSS_COMPILE", "0")
+    u = make("UniCross-Grasp-v1", grasp_file, compile_math=True).unwrapped
+    assert u._compiled and isinstance(u._step_math, GraphMethod) and isinstance(u._command_math, GraphMethod)
+    u = make("UniCross-Grasp-v1", grasp_file).unwrapped
+    assert not u._compiled and u._step_math == u._step_math_eager
+
+
 def _compare(task, kw, grasp_file):
     """Step a few times with random actions, then run one step's math eagerly and compiled
     (:class:`GraphMethod`, what ``UNICROSS_COMPILE=1`` runs on the CPU) from the same reads and the
@@ -304,3 +319,4 @@ def test_tracing_leaves_no_fake_constants_behind():
     got = owner.math(r)
     assert all(type(c) is torch.Tensor for c in G._CACHE.values())
     torch.testing.assert_close(got, G.quat_mul(torch.tensor([[0.6, 0.8, 0.0, 0.0]], dtype=torch.float64), r))
+

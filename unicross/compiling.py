@@ -23,7 +23,7 @@ import os
 import sys
 import time
 import weakref
-from typing import Callable, List
+from typing import Callable, List, Optional
 
 import torch
 import torch.utils._pytree as pytree
@@ -428,10 +428,10 @@ def _is_backend_error(e: Exception) -> bool:
     return mod.startswith(("torch._inductor", "torch._dynamo", "subprocess")) or isinstance(e, (OSError,))
 
 
-def compile_method(owner, fn: Callable, cpu: bool = True) -> Callable:
-    """The step math ``fn`` (a method of ``owner``) as the ``UNICROSS_COMPILE`` switch says: eager when
-    off; else a :class:`GraphMethod` on the CPU and ``torch.compile`` (:func:`maybe_compile`) on the
-    GPU or with ``UNICROSS_COMPILE=torch``."""
-    if not compile_enabled():
+def compile_method(owner, fn: Callable, cpu: bool = True, enabled: Optional[bool] = None) -> Callable:
+    """The step math ``fn`` (a method of ``owner``) as ``enabled`` (None: the ``UNICROSS_COMPILE``
+    switch) says: eager when off; else a :class:`GraphMethod` on the CPU and ``torch.compile``
+    (:func:`maybe_compile`) on the GPU or with ``UNICROSS_COMPILE=torch``."""
+    if not (compile_enabled() if enabled is None else enabled):
         return fn
     return GraphMethod(owner, fn) if cpu and not compile_with_dynamo() else maybe_compile(fn, cpu=cpu)

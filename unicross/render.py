@@ -255,7 +255,7 @@ class SapienBackend:
         self.target = traj.wrist_pose[:, :3].mean(0)
         self.size = (width, height)
         self.env = gym.make("UniCross-Grasp-v1", obs_mode="none", sim_backend="physx_cpu", render_backend="gpu",
-                            hand=traj.meta["hand"], objects=[obj], randomize=False,
+                            hand=traj.meta["hand"], objects=[obj], randomize=False, compile_math=False,
                             config=dict(table=bool(traj.meta.get("table", True))),
                             human_render_camera_configs=dict(width=width, height=height))
         self.u = self.env.unwrapped
