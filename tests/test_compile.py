@@ -320,3 +320,39 @@ def test_tracing_leaves_no_fake_constants_behind():
     assert all(type(c) is torch.Tensor for c in G._CACHE.values())
     torch.testing.assert_close(got, G.quat_mul(torch.tensor([[0.6, 0.8, 0.0, 0.0]], dtype=torch.float64), r))
 
+
+@pytest.mark.skipif(__import__("platform").machine() not in ("x86_64", "AMD64"), reason="x86 probes")
+def test_instruction_set_probes_run_once_per_machine(monkeypatch, tmp_path):
+    """Inductor's SIMD probes (a child Python per instruction set, ~8 s each on the lent machines with
+    torch 2.11) run in the first process only: it records their outcome in the cache directory, a
+    later process reads it and sets ``cpp.vec_isa_ok`` without probing, and a record where a probe
+    failed leaves Inductor to probe as before."""
+    import json
+    import unicross.compiling as c
+    from torch._inductor import config as ic
+    from torch._inductor import cpu_vec_isa as isa
+    monkeypatch.setattr(c, "_records_dir", lambda: tmp_path)  # Inductor's own cache as it is
+    real, probes = isa.valid_vec_isa_list, []
+    monkeypatch.setattr(isa, "valid_vec_isa_list", lambda: probes.append(1) or real())
+    try:
+        with ic.patch({"cpp.vec_isa_ok": None}):
+            c.settle_vec_isa.cache_clear()
+            skipped = c.settle_vec_isa()
+            (record,) = tmp_path.glob("unicross_vec_isa_*.json")
+            rec = json.loads(record.read_text())
+            assert probes == [1] and skipped == (rec["passed"] == rec["claimed"]) and rec["claimed"]
+            assert ic.cpp.vec_isa_ok is (True if skipped else None)
+        if not skipped:
+            pytest.skip(f"a probe failed on this machine ({rec}): nothing to skip")
+        monkeypatch.setattr(isa, "valid_vec_isa_list", lambda: pytest.fail("probed again"))
+        with ic.patch({"cpp.vec_isa_ok": None}):  # a later process
+            c.settle_vec_isa.cache_clear()
+            assert c.settle_vec_isa() and ic.cpp.vec_isa_ok is True
+            uncached = getattr(real, "__wrapped__", real)  # the same sets as the probes found
+            assert [str(v) for v in uncached()] == rec["passed"]
+        record.write_text(json.dumps(dict(rec, passed=rec["claimed"][1:])))  # a set the compiler failed
+        with ic.patch({"cpp.vec_isa_ok": None}):
+            c.settle_vec_isa.cache_clear()
+            assert not c.settle_vec_isa() and ic.cpp.vec_isa_ok is None
+    finally:
+        c.settle_vec_isa.cache_clear()

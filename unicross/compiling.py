@@ -55,6 +55,66 @@ def _announce_start() -> bool:
     return True
 
 
+def _records_dir():
+    """Inductor's cache directory (``TORCHINDUCTOR_CACHE_DIR`` or its default), where
+    :func:`settle_vec_isa` keeps its record."""
+    from pathlib import Path
+    try:
+        from torch._inductor.runtime.cache_dir_utils import cache_dir
+        return Path(cache_dir())
+    except ImportError:
+        import tempfile
+        return Path(os.environ.get("TORCHINDUCTOR_CACHE_DIR", tempfile.gettempdir()))
+
+
+@functools.cache
+def settle_vec_isa() -> bool:
+    """Runs Inductor's base probes of the machine's SIMD instruction sets once per machine, not once
+    per process; True when this process skips them.
+
+    Before its first CPU compile, Inductor checks which of the instruction sets the CPU reports
+    (AVX2, AVX-512, AMX, ...) the C++ compiler and torch support, by building a test library for each
+    and loading it in a child Python; up to torch 2.12 each child imports torch (~8 s each on the
+    lent 16-core machines with torch 2.11, where a fresh worker spent 60-100 s before its first step
+    with every graph in Inductor's cache: docs/runs/device16_render). The first process on a machine
+    runs the probes and records their outcome in Inductor's cache directory, keyed by torch, Python,
+    the C++ compiler and the sets the CPU reports; a later process that finds every reported set
+    passed sets ``torch._inductor.config.cpp.vec_isa_ok`` (the probes' own switch), which answers the
+    base probe of each set without building anything. So does the first process once it has probed,
+    so that all compile under one configuration (Inductor's cache keys include it). The sets' extra
+    probes (AVX-512 VNNI and bf16, AMX) do not read the switch and still run: measured, a fresh
+    process's probes 1.5 -> 0.35 s on the 2-core VM (torch 2.13), 10 -> 6 child processes (89-102 ->
+    61 s to the first step, one run each) on a lent machine. Nothing changes where a probe failed,
+    where ``vec_isa_ok`` or ``TORCHINDUCTOR_VEC_ISA_OK`` is already set, or off x86."""
+    import hashlib
+    import json
+    import platform
+    try:
+        from torch._inductor import config as ic
+        from torch._inductor import cpu_vec_isa as isa
+        if ic.cpp.vec_isa_ok is not None or platform.machine() not in ("x86_64", "AMD64"):
+            return False
+        flags = isa.x86_isa_checker()
+        claimed = [str(v) for v in isa.supported_vec_isa_list if all(f in flags for f in str(v).split())]
+        key = hashlib.sha256(json.dumps([torch.__version__, sys.executable, str(ic.cpp.cxx), claimed]).encode())
+        root = _records_dir()
+        record = root / f"unicross_vec_isa_{key.hexdigest()[:16]}.json"
+        try:
+            passed = json.loads(record.read_text())["passed"]
+        except (OSError, ValueError, KeyError, TypeError):
+            passed = [str(v) for v in isa.valid_vec_isa_list()]  # the probes, in this process
+            root.mkdir(parents=True, exist_ok=True)
+            tmp = record.with_suffix(f".{os.getpid()}.tmp")
+            tmp.write_text(json.dumps(dict(torch=torch.__version__, claimed=claimed, passed=passed)))
+            os.replace(tmp, record)
+    except Exception:  # an optimisation over torch internals: never a reason to fail a compile
+        return False
+    if passed != claimed:
+        return False
+    ic.cpp.vec_isa_ok = True
+    return True
+
+
 def _fall_back(e: Exception) -> None:
     print(f"[unicross] compiling the step math failed ({str(e).strip().splitlines()[0][:200]}); running it "
           "eagerly (install a C++ compiler, e.g. g++, or set UNICROSS_COMPILE=0 to skip the attempt)",
@@ -83,6 +143,8 @@ def maybe_compile(fn: Callable, cpu: bool = True) -> Callable:
     def call(*args, **kwargs):
         announce = impl[0] is compiled and _announce_start()
         t = time.perf_counter()
+        if announce and cpu:
+            settle_vec_isa()
         try:
             out = impl[0](*args, **kwargs)
         except torch._dynamo.exc.BackendCompilerFailed as e:  # e.g. no working C++ compiler
@@ -351,6 +413,7 @@ class GraphMethod:
         from torch._inductor import config as inductor_config
         from torch._inductor.compile_fx import compile_fx
 
+        settle_vec_isa()
         d = owner.__dict__
         names = [n for n, v in d.items() if _is_state(v)]
         specs = [pytree.tree_flatten(d[n]) for n in names]
