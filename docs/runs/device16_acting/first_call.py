@@ -37,12 +37,12 @@ for _ in range(20):
     u.step(torch.zeros(1, u.hand_spec.dof))
 later = (time.perf_counter() - t) / 20
 s = io.StringIO()
-pstats.Stats(prof, stream=s).sort_stats("cumulative").print_stats(45)
+pstats.Stats(prof, stream=s).sort_stats("cumulative").print_stats(70)
 import torch._inductor.config as ic  # noqa: E402
 
 print(json.dumps(dict(first_step_s=round(first, 2), later_step_ms=round(later * 1e3, 2),
                       make_and_reset_s=round(t_made - t_import, 2), cores=os.cpu_count(),
                       compile_threads=ic.compile_threads, torch=torch.__version__,
                       env={k: v for k, v in os.environ.items() if k.startswith(("TORCHINDUCTOR", "UNICROSS"))},
-                      profile=s.getvalue().splitlines()[:80]), indent=1))
+                      profile=s.getvalue().splitlines()[:100]), indent=1))
 env.close()
