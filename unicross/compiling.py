@@ -77,8 +77,10 @@ def settle_vec_isa() -> bool:
     and loading it in a child Python; up to torch 2.12 each child imports torch (~8 s each on the
     lent 16-core machines with torch 2.11, where a fresh worker spent 60-100 s before its first step
     with every graph in Inductor's cache: docs/runs/device16_render). The first process on a machine
-    runs the probes and records their outcome in Inductor's cache directory, keyed by torch, Python,
-    the C++ compiler and the sets the CPU reports; a later process that finds every reported set
+    runs the probes and records their outcome in Inductor's cache directory (``unicross_vec_isa_*.json``),
+    keyed by torch, Python, the C++ compiler's name (not its version: delete the record after changing
+    compilers; a stale one can only make a compile fail, which runs the math eagerly as any compile
+    error does) and the sets the CPU reports; a later process that finds every reported set
     passed sets ``torch._inductor.config.cpp.vec_isa_ok`` (the probes' own switch), which answers the
     base probe of each set without building anything. So does the first process once it has probed,
     so that all compile under one configuration (Inductor's cache keys include it). The sets' extra
