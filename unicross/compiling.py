@@ -57,14 +57,10 @@ def _announce_start() -> bool:
 
 def _records_dir():
     """Inductor's cache directory (``TORCHINDUCTOR_CACHE_DIR`` or its default), where
-    :func:`settle_vec_isa` keeps its record."""
+    :func:`settle_vec_isa` keeps its record (an import error there leaves the probes as they are)."""
     from pathlib import Path
-    try:
-        from torch._inductor.runtime.cache_dir_utils import cache_dir
-        return Path(cache_dir())
-    except ImportError:
-        import tempfile
-        return Path(os.environ.get("TORCHINDUCTOR_CACHE_DIR", tempfile.gettempdir()))
+    from torch._inductor.runtime.cache_dir_utils import cache_dir
+    return Path(cache_dir())
 
 
 @functools.cache
