@@ -45,6 +45,22 @@ def parse_sequence(seq: str | Sequence[str]) -> List[str]:
     return modes
 
 
+def chain_categories(modes: Sequence[str]) -> set:
+    """The object categories that can do every phase of ``modes`` (rotate: wrappable, translate:
+    elongated, grasp and relocate: both)."""
+    return set.intersection(*(set(skill_of_mode(m).categories) for m in modes))
+
+
+def objects_for_chain(objects: Sequence, modes: Sequence[str]) -> list:
+    """The objects of ``objects`` that can do every phase of ``modes``; raises when none can."""
+    cats = chain_categories(modes)
+    objs = [o for o in objects if o.category in cats]
+    if not objs:
+        raise ValueError(f"no object of the set can do every phase of {list(modes)} "
+                         f"(rotate needs wrappable objects, translate elongated ones)")
+    return objs
+
+
 @register_task("UniCross-Chain-v1", max_episode_steps=sum(PHASE_STEPS.values()))
 class ChainEnv(UniCrossEnv):
     """Grasp, then the following phases in one continuous episode with one policy."""
@@ -56,17 +72,12 @@ class ChainEnv(UniCrossEnv):
         steps = dict(PHASE_STEPS, **(phase_steps or {}))
         self.phase_lengths = [steps[F.mode_skill(m)] for m in self.sequence]
         self.phase_ends = torch.cumsum(torch.tensor(self.phase_lengths), 0).tolist()
-        cats = set.intersection(*(set(skill_of_mode(m).categories) for m in self.sequence))
-        self._chain_categories = cats
         cfg = dict(kwargs.pop("config", None) or {})
         cfg.setdefault("episode_length", {})[F.mode_skill(self.sequence[0])] = self.phase_ends[-1]
         objects = kwargs.pop("objects", None) or self.DEFAULT_OBJECTS
         limit = kwargs.pop("object_limit", None)
         objs = get_object_set(objects, limit=limit) if isinstance(objects, str) else resolve_objects(objects)
-        objs = [o for o in objs if o.category in cats]  # only objects that can do every phase
-        if not objs:
-            raise ValueError(f"no object of the set can do every phase of {self.sequence} "
-                             f"(rotate needs wrappable objects, translate elongated ones)")
+        objs = objects_for_chain(objs, self.sequence)  # only objects that can do every phase
         super().__init__(*args, modes=(self.sequence[0],), objects=objs, config=cfg, **kwargs)
 
     TASK_STATE = UniCrossEnv.TASK_STATE + ("phase", "phase_success")

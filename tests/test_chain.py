@@ -87,6 +87,20 @@ def test_chain_command_runs_a_policy_and_writes_every_trial(tmp_path):
     assert all(len(t["phase_success"]) == 2 for t in r["trials"])
 
 
+def test_a_fixed_sequence_runs_on_the_objects_that_can_do_it():
+    """``unicross chain --sequence grasp,rotate:x+`` on a set with sticks runs the wrappable objects and
+    leaves the sticks out (it used to stop with an error at the first stick, after the trials before it,
+    writing nothing); a set with no object for the sequence fails before any simulation."""
+    from unicross import evaluation as E
+    from unicross.objects import get_object_set
+    stick, ball = get_object_set("test-elongated", limit=1)[0], get_object_set("test-wrappable", limit=1)[0]
+    zero, _ = E.resolve_policy("zero", "allegro")
+    trials = E.run_chain(zero, [stick, ball], "grasp,rotate:x+", trials_per_object=1, progress=False)
+    assert [t["object"] for t in trials] == [ball.name]
+    with pytest.raises(ValueError, match="no object of the set can do every phase"):
+        E.run_chain(zero, [stick], "grasp,rotate:x+", trials_per_object=1, progress=False)
+
+
 def test_chain_state_round_trip_keeps_the_phase():
     """The phase and phase successes are task state: restoring a state taken in the second phase
     after the episode moved on to the third brings the phase and mode back."""

@@ -453,8 +453,12 @@ def run_chain(policy: PolicyFn, objects: Sequence[ObjectSpec], sequence: Optiona
     """Long-horizon protocol: grasp -> relocate -> in-hand from random table poses in one episode.
 
     ``sequence`` None: the paper's protocol (wrappable objects: rotate about a random axis;
-    elongated: translate along a random direction); otherwise e.g. 'grasp,relocate,rotate:x+'."""
-    from unicross.tasks.chain import parse_sequence
+    elongated: translate along a random direction); otherwise e.g. 'grasp,relocate,rotate:x+', run
+    on the objects that can do every phase (the others are left out; none raises before any
+    simulation)."""
+    from unicross.tasks.chain import objects_for_chain, parse_sequence
+    if sequence is not None:
+        objects = objects_for_chain(objects, parse_sequence(sequence))
     rng = torch.Generator().manual_seed(seed)
     trials = []
     bar = tqdm(total=len(objects) * trials_per_object, desc="eval chain", disable=not progress)
