@@ -117,8 +117,10 @@ class ChainEnv(UniCrossEnv):
         ph = self.phase
         at_end = self.elapsed_steps >= self._phase_end[ph]
         seen = self.phase_success[envs, ph]
-        # rotate/translate: "exceeded within the phase"; grasp/relocate: at the end of the phase
-        self.phase_success[envs, ph] = torch.where(self._phase_once[ph], seen | info["success"],
+        # rotate/translate: exceeded within the phase and never dropped in it (a drop later in the phase
+        # takes the success back, as the per-skill protocol's ``dropped`` does); grasp/relocate: at the
+        # end of the phase
+        self.phase_success[envs, ph] = torch.where(self._phase_once[ph], (seen | info["success"]) & ~info["drop"],
                                                    torch.where(at_end, info["success"], seen))
         switch = at_end & (ph + 1 < len(self.sequence))
         if bool(switch.any()):

@@ -101,6 +101,29 @@ def test_a_fixed_sequence_runs_on_the_objects_that_can_do_it():
         E.run_chain(zero, [stick], "grasp,rotate:x+", trials_per_object=1, progress=False)
 
 
+def test_an_in_hand_phase_that_drops_after_its_threshold_fails():
+    """The per-skill protocol counts a rotation past pi/2 only if the object is never dropped in the
+    episode; the chain's in-hand phase does too: a drop after the threshold takes the success back."""
+    env = make("UniCross-Chain-v1", objects="test-wrappable", sequence="grasp,rotate:y-",
+               phase_steps=dict(grasp=60, rotate=20), randomize=False)
+    u = env.unwrapped
+    env.reset(seed=1)
+    policy = ScriptedGrasp(u)
+    for t in range(60):
+        env.step(policy() if t < 55 else torch.zeros(1, 22))
+    assert u.phase.item() == 1 and u.phase_success[0, 0]  # lifted, now in the rotate phase
+    u.rot_acc = torch.full_like(u.rot_acc, 2.0)  # past pi/2 (as if turned)
+    _, _, term, _, info = env.step(torch.zeros(1, 22))
+    assert not term.any() and info["phase_success"][0, 1]
+    from mani_skill.utils.structs.pose import Pose
+    p = u.obj.pose.p.clone()
+    p[:, 2] += 1.0  # the object leaves the hand
+    u.obj.set_pose(Pose.create_from_pq(p, u.obj.pose.q))
+    _, _, term, _, info = env.step(torch.zeros(1, 22))
+    assert term.all() and info["drop"].all()
+    assert not info["phase_success"][0, 1] and info["phase_success"][0, 0]
+
+
 def test_chain_state_round_trip_keeps_the_phase():
     """The phase and phase successes are task state: restoring a state taken in the second phase
     after the episode moved on to the third brings the phase and mode back."""
