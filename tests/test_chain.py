@@ -16,13 +16,17 @@ def test_sequence_parsing():
         parse_sequence("relocate,rotate:x+")
 
 
+def _grasping_chain(sequence: str, seed: int, **phase_steps):
+    """A one-env chain on a test wrappable object, reset with ``seed``, and the scripted grasp acting on it."""
+    env = make("UniCross-Chain-v1", objects="test-wrappable", sequence=sequence, phase_steps=phase_steps,
+               randomize=False)
+    env.reset(seed=seed)
+    return env, env.unwrapped, ScriptedGrasp(env.unwrapped)
+
+
 def test_chain_switches_modes_continuously():
-    env = make("UniCross-Chain-v1", objects="test-wrappable", sequence="grasp,relocate,rotate:y-",
-               phase_steps=dict(grasp=60, relocate=10, rotate=10), randomize=False)
-    u = env.unwrapped
-    env.reset(seed=1)
+    env, u, policy = _grasping_chain("grasp,relocate,rotate:y-", 1, grasp=60, relocate=10, rotate=10)
     assert u.phase_ends == [60, 70, 80] and u.mode.item() == F.MODES.index("grasp")
-    policy = ScriptedGrasp(u)
     modes, info = [], None
     for t in range(80):
         a = policy() if t < 55 else torch.zeros(1, 22)
@@ -43,11 +47,7 @@ def test_chain_switches_modes_continuously():
 
 
 def test_no_teleport_across_the_switch():
-    env = make("UniCross-Chain-v1", objects="test-wrappable", sequence="grasp,relocate",
-               phase_steps=dict(grasp=58, relocate=5), randomize=False)
-    u = env.unwrapped
-    env.reset(seed=2)
-    policy = ScriptedGrasp(u)
+    env, u, policy = _grasping_chain("grasp,relocate", 2, grasp=58, relocate=5)
     for _ in range(57):
         env.step(policy())
     # step 58 ends the grasp phase; record the world state right before the switch is applied
@@ -104,11 +104,7 @@ def test_a_fixed_sequence_runs_on_the_objects_that_can_do_it():
 def test_an_in_hand_phase_that_drops_after_its_threshold_fails():
     """The per-skill protocol counts a rotation past pi/2 only if the object is never dropped in the
     episode; the chain's in-hand phase does too: a drop after the threshold takes the success back."""
-    env = make("UniCross-Chain-v1", objects="test-wrappable", sequence="grasp,rotate:y-",
-               phase_steps=dict(grasp=60, rotate=20), randomize=False)
-    u = env.unwrapped
-    env.reset(seed=1)
-    policy = ScriptedGrasp(u)
+    env, u, policy = _grasping_chain("grasp,rotate:y-", 1, grasp=60, rotate=20)
     for t in range(60):
         env.step(policy() if t < 55 else torch.zeros(1, 22))
     assert u.phase.item() == 1 and u.phase_success[0, 0]  # lifted, now in the rotate phase
