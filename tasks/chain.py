@@ -45,15 +45,10 @@ def parse_sequence(seq: str | Sequence[str]) -> List[str]:
     return modes
 
 
-def chain_categories(modes: Sequence[str]) -> set:
-    """The object categories that can do every phase of ``modes`` (rotate: wrappable, translate:
-    elongated, grasp and relocate: both)."""
-    return set.intersection(*(set(skill_of_mode(m).categories) for m in modes))
-
-
 def objects_for_chain(objects: Sequence, modes: Sequence[str]) -> list:
-    """The objects of ``objects`` that can do every phase of ``modes``; raises when none can."""
-    cats = chain_categories(modes)
+    """The objects of ``objects`` whose category can do every phase of ``modes`` (rotate: wrappable,
+    translate: elongated, grasp and relocate: both); raises when none can."""
+    cats = set.intersection(*(set(skill_of_mode(m).categories) for m in modes))
     objs = [o for o in objects if o.category in cats]
     if not objs:
         raise ValueError(f"no object of the set can do every phase of {list(modes)} "

@@ -9,15 +9,8 @@ import json
 import sys
 from collections import defaultdict
 
+from unicross.metrics import wilson_interval
 
-def wilson(k, n, z=1.96):
-    if n == 0:
-        return (0, 0)
-    p = k / n
-    d = 1 + z * z / n
-    c = (p + z * z / (2 * n)) / d
-    h = z * ((p * (1 - p) / n + z * z / (4 * n * n)) ** 0.5) / d
-    return (100 * (c - h), 100 * (c + h))
 
 
 for f in sys.argv[1:]:
@@ -31,4 +24,5 @@ for f in sys.argv[1:]:
         g[kind][0] += 1
         g[kind][1] += old
         g[kind][2] += new
-    print(f, {k: f"old {v[1]}/{v[0]}, new {v[2]}/{v[0]} [{wilson(v[2], v[0])[0]:.0f}-{wilson(v[2], v[0])[1]:.0f}]" for k, v in g.items()})
+    ci = {k: [100 * x for x in wilson_interval(v[2], v[0])] for k, v in g.items()}
+    print(f, {k: f"old {v[1]}/{v[0]}, new {v[2]}/{v[0]} [{ci[k][0]:.0f}-{ci[k][1]:.0f}]" for k, v in g.items()})

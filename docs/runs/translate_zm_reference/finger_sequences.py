@@ -22,19 +22,24 @@ from unicross.sequences import make_sequence_policy
 torch.set_num_threads(1)
 
 
+def score_line(spec: str, trials, width: int = 70) -> str:
+    """One line per scored motion: successes, drops and successes by shape (also used by ratchet.py, wrist_shake.py)."""
+    n, ok = len(trials), sum(t["success"] for t in trials)
+    drops = sum(t["dropped"] for t in trials)
+    by_shape = {}
+    for t in trials:  # object names are CATEGORY-SHAPE-SET-INDEX
+        by_shape.setdefault(t["object"].split("-")[1], []).append(t["success"])
+    shapes = ", ".join(f"{k} {sum(v)}/{len(v)}" for k, v in sorted(by_shape.items()))
+    return f"{spec:{width}s} success {ok}/{n} ({100 * ok / n:.1f}%), drops {drops}; {shapes}"
+
+
 def main() -> None:
     specs = sys.argv[1].split("|")
     objs = get_object_set(sys.argv[2], limit=int(sys.argv[3]))
     for spec in specs:
         trials = E.run_protocol("translate", make_sequence_policy(spec), objs, trials_per_object=int(sys.argv[4]), seed=0,
                                 axes=["z-"], progress=False, grasp_dataset=os.environ.get("UNICROSS_GRASPS"))
-        n, ok = len(trials), sum(t["success"] for t in trials)
-        drops = sum(t["dropped"] for t in trials)
-        by_shape = {}
-        for t in trials:  # object names are CATEGORY-SHAPE-SET-INDEX
-            by_shape.setdefault(t["object"].split("-")[1], []).append(t["success"])
-        shapes = ", ".join(f"{k} {sum(v)}/{len(v)}" for k, v in sorted(by_shape.items()))
-        print(f"{spec:70s} success {ok}/{n} ({100 * ok / n:.1f}%), drops {drops}; {shapes}", flush=True)
+        print(score_line(spec, trials), flush=True)
 
 
 if __name__ == "__main__":

@@ -18,6 +18,8 @@ from unicross.audit import finger_sweep_action
 from unicross.objects import get_object_set
 from unicross.sequences import make_sequence_policy
 
+from finger_sequences import score_line  # this folder's scorer
+
 torch.set_num_threads(1)
 OTHERS = {"index": "ring:2:0.05:@index:0.9+middle:2:0.05:0:1000",
           "middle": "index:2:0.1:0:1000+ring:2:0.05:@index:0.9",
@@ -51,12 +53,7 @@ def main() -> None:
         finger, *p = spec.split(",")
         trials = E.run_protocol("translate", make(finger, *[float(x) for x in p]), objs,
                                 trials_per_object=int(sys.argv[4]), seed=0, axes=["z-"], progress=False)
-        n, ok = len(trials), sum(t["success"] for t in trials)
-        by = {}
-        for t in trials:
-            by.setdefault(t["object"].split("-")[1], []).append(t["success"])
-        print(f"{spec:28s} success {ok}/{n} ({100 * ok / n:.1f}%), drops {sum(t['dropped'] for t in trials)}; "
-              + ", ".join(f"{k} {sum(v)}/{len(v)}" for k, v in sorted(by.items())), flush=True)
+        print(score_line(spec, trials, width=28), flush=True)
 
 
 if __name__ == "__main__":

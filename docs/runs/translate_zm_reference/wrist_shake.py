@@ -9,6 +9,8 @@ from unicross import evaluation as E
 from unicross.objects import get_object_set
 from unicross.sequences import make_sequence_policy
 from unicross.geometry import quat_apply
+
+from finger_sequences import score_line  # this folder's scorer
 torch.set_num_threads(1)
 RELAY = "index:2:0.1:0:1000+ring:2:0.05:@index:0.9+middle:2:0.05:@ring:0.9"
 
@@ -29,9 +31,4 @@ objs = get_object_set(sys.argv[2], limit=int(sys.argv[3]))
 for spec in sys.argv[1].split("|"):
     p = [float(x) for x in spec.split(",")]
     trials = E.run_protocol("translate", make(*p), objs, trials_per_object=int(sys.argv[4]), seed=0, axes=["z-"], progress=False)
-    n, ok = len(trials), sum(t["success"] for t in trials)
-    drops = sum(t["dropped"] for t in trials)
-    by = {}
-    for t in trials:
-        by.setdefault(t["object"].split("-")[1], []).append(t["success"])
-    print(f"{spec:20s} success {ok}/{n} ({100*ok/n:.1f}%), drops {drops}; " + ", ".join(f"{k} {sum(v)}/{len(v)}" for k, v in sorted(by.items())), flush=True)
+    print(score_line(spec, trials, width=20), flush=True)
