@@ -52,6 +52,9 @@ the y- gaits, reversed, gave y+ the gait it ships (section "Scripted rotation ga
         --steps 400 --amplitude 0.6 --no-randomize --limit 4 --generations 6 --sigma 0.15 --select 6 \
         --select-seeds 4 --out docs/runs/gait_search/rotate_y+_reversed.jsonl
 
+``--grasps PATH`` starts the episodes from another grasp-state dataset (default: the shipped one, the grasp
+expert's), e.g. ``configs/grasps/allegro_scripted.pt`` (docs/runs/gait_search/thumb_grasps/).
+
 Episodes run in two spawned worker processes, one env per object each.
 """
 from __future__ import annotations
@@ -72,7 +75,7 @@ _ENVS = {}
 
 
 def _env(job):
-    key = (job["skill"], job["axis"], job["objects"], job["limit"], job["oi"], job["randomize"])
+    key = (job["skill"], job["axis"], job["objects"], job["limit"], job["oi"], job["randomize"], job["grasps"])
     if key not in _ENVS:
         import gymnasium as gym
         import unicross  # noqa: F401  (registers the tasks)
@@ -84,6 +87,8 @@ def _env(job):
         kw.pop("object_limit", None)
         kw.pop("reconfiguration_freq", None)
         kw["randomize"] = job["randomize"]
+        if job["grasps"] is not None:
+            kw["grasp_dataset"] = job["grasps"]
         obj = get_object_set(job["objects"], limit=job["limit"])[job["oi"]]
         _ENVS[key] = gym.make(skill_entry(job["skill"]).env_id, obs_mode="state", sim_backend="physx_cpu",
                               render_backend="none", num_envs=1, **{**kw, "objects": [obj]})
@@ -136,7 +141,8 @@ def evaluate(pool, gaits, args, n_obj, first: int = 0, hold=None, seeds=None):
     seeds = list(range(args.seeds)) if seeds is None else list(seeds)
     jobs = [dict(p=p.tolist(), oi=oi, seed=trial_seed(0, oi, k), skill=args.skill, axis=args.axis,
                  objects=args.objects, limit=args.limit, randomize=not args.no_randomize, steps=args.steps,
-                 amplitude=args.amplitude, finger=(first + i) % 4 if args.one_finger else None, hold=hold)
+                 amplitude=args.amplitude, finger=(first + i) % 4 if args.one_finger else None, hold=hold,
+                 grasps=args.grasps)
             for i, p in enumerate(gaits) for oi in range(n_obj) for k in seeds]
     return np.array(pool.map(episode, jobs, chunksize=1)).reshape(len(gaits), n_obj * len(seeds), 9)
 
@@ -219,6 +225,8 @@ def main():
     ap.add_argument("--hold", action="store_true",
                     help="--refine: the gait stops once the motion exceeds the success threshold, the fingers hold "
                          "to --steps; score = the protocol's success (exceeded, never dropped)")
+    ap.add_argument("--grasps", default=None,
+                    help="grasp-state dataset the episodes start from (default: the shipped one, the grasp expert's)")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--out", default=None)
     ap.add_argument("--summary", nargs="+", default=None)
