@@ -4,7 +4,7 @@ import torch
 
 from unicross.grasps import GraspSet, default_grasp_path
 from unicross.objects import get_object_set
-from unicross.scripted_grasp import hold_test, synthesize
+from unicross.scripted_grasp import contact_link_fingers, finger_census, hold_test, synthesize
 
 
 def test_scripted_grasps_hold_for_two_seconds():
@@ -12,8 +12,14 @@ def test_scripted_grasps_hold_for_two_seconds():
     gs, stats = synthesize("allegro", objs, per_object=2, seed=3, progress=False)
     # the synthesiser's own criterion: lifted, >= 2 links in contact, held 2 s in the air
     assert stats["success_rate"] >= 0.8
-    held = hold_test("allegro", gs, objs, seconds=2.0)
+    held, touching = hold_test("allegro", gs, objs, seconds=2.0)
     assert len(held) == len(gs) and sum(held) / len(held) >= 0.8
+    # the scripted grasp opposes the thumb to the other fingers: every grasp that held has the thumb and
+    # at least one other finger on the object; a dropped grasp touches nothing
+    assert all(("thumb" in t and len(set(t) - {"thumb", "palm"}) >= 1) if h else t == () for h, t in zip(held, touching))
+    census = finger_census(gs, objs, touching, rows=held)
+    assert set(census) == {"wrappable"} and census["wrappable"]["grasps"] == sum(held)
+    assert census["wrappable"]["touching"]["thumb"] == sum(held) == sum(census["wrappable"]["sets"].values())
     # the dataset describes physically settled grasps: fingers at rest near their PD targets, except
     # those pressed against the object, which sit short of their closing target (by how much depends on
     # where the object lies in the hand, i.e. on the task generator's draws: 0.3-0.9 rad seen); no
@@ -49,3 +55,21 @@ def test_shipped_dataset_covers_training_and_test_objects():
         assert sum(counts.get(n, 0) > 0 for n in names) >= 0.95 * len(names), set_name
     scripted = GraspSet.load(default_grasp_path("allegro").with_name("allegro_scripted.pt"))
     assert scripted.source == "scripted" and len(scripted) > 1000
+
+
+@pytest.mark.parametrize("hand", ["allegro", "mano", "inspire"])
+def test_every_contact_link_belongs_to_its_finger_or_the_palm(hand):
+    """Links are assigned by walking up the kinematic tree: Allegro's fingertip links (fixed joints) and
+    Inspire's mimic-driven distal links go to their finger, the palm links to "palm"."""
+    import gymnasium as gym
+    objs = get_object_set("train-wrappable", limit=1)[:1]
+    env = gym.make("UniCross-Relocate-v1", obs_mode="none", sim_backend="physx_cpu", render_backend="none",
+                   hand=hand, objects=objs, randomize=False, grasp_dataset=None if hand == "allegro" else
+                   default_grasp_path(hand))
+    u = env.unwrapped
+    fingers = contact_link_fingers(u)
+    env.close()
+    assert len(fingers) == len(u.hand_spec.contact_links)
+    assert set(fingers) == set(u.hand_spec.fingers) | {"palm"}
+    if hand == "allegro":  # configs/hands/allegro.yaml: base_link, then 5 links per finger in joint order
+        assert fingers == ["palm"] + ["index"] * 5 + ["middle"] * 5 + ["ring"] * 5 + ["thumb"] * 5

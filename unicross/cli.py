@@ -59,7 +59,7 @@ def _cmd_grasps(args) -> int:
     from unicross.grasps import GraspSet
     from unicross.objects import get_object_set
     from unicross.robots.hand import load_hand
-    from unicross.scripted_grasp import hold_test, synthesize
+    from unicross.scripted_grasp import finger_census, hold_test, synthesize
     from unicross.rl.ppo import git_commit
     load_hand(args.hand)  # validates
     commit = git_commit()  # the code that makes the grasps (HEAD may move while they are made)
@@ -74,8 +74,9 @@ def _cmd_grasps(args) -> int:
         gs, stats = expert_grasps(args.expert, objs, args.per_object, seed=args.seed)
     else:
         gs, stats = synthesize(args.hand, objs, args.per_object, seed=args.seed, randomize=args.randomize)
-    held = hold_test(args.hand, gs, objs, seconds=2.0, seed=args.seed) if args.hold_test else []
+    held, touching = hold_test(args.hand, gs, objs, seconds=2.0, seed=args.seed) if args.hold_test else ([], [])
     found = len(gs)
+    census = finger_census(gs, objs, touching, rows=held) if held else None
     if held and not args.keep_all:  # the dataset keeps the grasps that hold
         gs = GraspSet(gs.hand, gs.object_names, gs.data[torch.tensor(held)], gs.source)
     if args.append and out.exists():
@@ -87,10 +88,13 @@ def _cmd_grasps(args) -> int:
                    grasps=len(gs), found=found, synthesis_success_rate=round(stats["success_rate"], 4),
                    hold_2s_rate=round(sum(held) / len(held), 4) if held else None,
                    kept=("all" if args.keep_all or not held else "holding"),
-                   per_object=gs.counts(), seconds=round(took, 1))
+                   fingers_after_hold=census, per_object=gs.counts(), seconds=round(took, 1))
     print(f"{'expert' if args.expert else 'scripted'} success {stats['success_rate']:.1%}, {found} grasps"
           + (f"; restored grasps holding for 2 s: {sum(held)}/{len(held)} = {sum(held) / len(held):.1%}" if held else "")
           + f"; wrote {len(gs)} grasps ({summary['kept']}) of {len(objs)} objects to {out} in {took:.0f}s")
+    for cat, c in (census or {}).items():
+        print(f"{cat}: fingers touching the object after the 2 s hold, of {c['grasps']} grasps that held: "
+              + ", ".join(f"{f} {n}" for f, n in sorted(c["touching"].items(), key=lambda kv: -kv[1])))
     short = [n for n, c in gs.counts().items() if c < args.per_object]
     if short:
         print(f"{len(short)} object(s) got fewer than {args.per_object} grasps, e.g. {short[:3]}")

@@ -15,7 +15,7 @@ wrist pose, object pose in the hand frame) is the grasp dataset format of :mod:`
 """
 from __future__ import annotations
 
-from typing import Optional, Sequence
+from typing import List, Optional, Sequence, Tuple
 
 import gymnasium as gym
 import torch
@@ -138,14 +138,35 @@ def grasp_state(u, e: int, object_id: int) -> dict:
                 object_id=torch.tensor(object_id))
 
 
+def contact_link_fingers(u) -> List[str]:
+    """The finger (a key of the hand's ``fingers``) each contact link of the task ``u`` belongs to, in
+    the order of ``hand_spec.contact_links``: the first finger joint met walking up the kinematic tree
+    from the link (a fingertip's fixed joint or a mimic joint leads on to its finger); ``"palm"`` for
+    links above every finger joint."""
+    owner = {j: f for f, joints in u.hand_spec.fingers.items() for j in joints}
+    out = []
+    for link in u.contact_links:
+        finger, joint = "palm", link.joint
+        while joint is not None:
+            if joint.name in owner:
+                finger = owner[joint.name]
+                break
+            joint = joint.parent_link.joint if joint.parent_link is not None else None
+        out.append(finger)
+    return out
+
+
 def hold_test(hand: str, grasps: GraspSet, objects: Sequence[ObjectSpec], seconds: float = 2.0,
-              seed: int = 0, randomize: bool = False):
+              seed: int = 0, randomize: bool = False) -> Tuple[List[bool], List[Tuple[str, ...]]]:
     """Restore each grasp in UniCross-Relocate-v1 with the final pose equal to the start (the wrist
     holds still), keep the fingers at their recorded targets for ``seconds`` and report, per grasp
-    (a list aligned with the dataset's rows; rows of objects not in ``objects`` count as not held),
-    whether the object stayed in the hand (never dropped)."""
+    (lists aligned with the dataset's rows; rows of objects not in ``objects`` count as not held):
+    whether the object stayed in the hand (never dropped), and the fingers (and ``"palm"``) touching
+    it at the end (a link's net contact force above the task's ``contact_force_threshold``; empty
+    when it dropped): which fingers a dataset's grasps hold with (:func:`finger_census`)."""
     import unicross  # noqa: F401
     held = [False] * len(grasps)
+    touching: List[Tuple[str, ...]] = [()] * len(grasps)
     by_name = {o.name: o for o in objects}
     for oi, name in enumerate(grasps.object_names):
         mask = grasps.data["object_id"] == oi
@@ -157,6 +178,7 @@ def hold_test(hand: str, grasps: GraspSet, objects: Sequence[ObjectSpec], second
                        hand=hand, objects=[by_name[name]], randomize=randomize, grasp_dataset=sub,
                        config=dict(relocate_target=dict(xy=0.0, z=[0.0, 0.0], rpy=0.0)))
         u = env.unwrapped
+        fingers = contact_link_fingers(u)
         for k, row in enumerate(torch.nonzero(mask).flatten().tolist()):
             u.grasps = GraspSet(hand, [name], sub.data[k:k + 1], grasps.source)  # exactly this grasp
             u.reset(seed=seed + k)
@@ -165,5 +187,30 @@ def hold_test(hand: str, grasps: GraspSet, objects: Sequence[ObjectSpec], second
             for _ in range(int(round(seconds / u.control_dt))):
                 _, _, _, _, info = u.step(zero)
             held[row] = bool((~info["ever_dropped"]).item())
+            if held[row]:
+                touch = (u.link_force[0] > u.cfg["contact_force_threshold"]).tolist()
+                touched = {f for t, f in zip(touch, fingers) if t}
+                touching[row] = tuple(f for f in dict.fromkeys(fingers) if f in touched)  # in link order
         env.close()
-    return held
+    return held, touching
+
+
+def finger_census(grasps: GraspSet, objects: Sequence[ObjectSpec], touching: Sequence[Tuple[str, ...]],
+                  rows: Optional[Sequence[bool]] = None) -> dict:
+    """Per object category, over the dataset's rows (those where ``rows`` is true): the number of
+    grasps, how many each finger (and the palm) touches at the end of :func:`hold_test`, and the
+    sets of touching fingers by frequency (``"index+ring": 79``)."""
+    category = {o.name: o.category for o in objects}
+    out: dict = {}
+    for i, oid in enumerate(grasps.data["object_id"].tolist()):
+        if rows is not None and not rows[i]:
+            continue
+        c = out.setdefault(category.get(grasps.object_names[oid], "other"), dict(grasps=0, touching={}, sets={}))
+        c["grasps"] += 1
+        for f in touching[i]:
+            c["touching"][f] = c["touching"].get(f, 0) + 1
+        key = "+".join(touching[i]) or "none"
+        c["sets"][key] = c["sets"].get(key, 0) + 1
+    for c in out.values():
+        c["sets"] = dict(sorted(c["sets"].items(), key=lambda kv: -kv[1]))
+    return out
