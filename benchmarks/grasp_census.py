@@ -28,8 +28,8 @@ def _part(path: str, names: list, seed: int):
     from unicross.grasps import GraspSet
     from unicross.objects import get_object_set
     from unicross.scripted_grasp import hold_test
-    gs = GraspSet.load(path)
-    objs = [o for s in ("train", "test", "unseen") for o in get_object_set(s) if o.name in set(names)]
+    gs, wanted = GraspSet.load(path), set(names)
+    objs = [o for s in ("train", "test", "unseen") for o in get_object_set(s) if o.name in wanted]
     held, touching = hold_test(gs.hand, gs, objs, seconds=2.0, seed=seed)
     return held, touching
 

@@ -16,9 +16,7 @@ import torch
 import unicross  # noqa: F401
 from unicross.geometry import quat_apply, quat_inv
 from unicross.objects import get_object_set
-
-# Allegro's contact links in the order of configs/hands/allegro.yaml: palm, then 5 links per finger
-FINGERS = {"index": range(1, 6), "middle": range(6, 11), "ring": range(11, 16), "thumb": range(16, 21)}
+from unicross.scripted_grasp import contact_link_fingers
 
 if __name__ == "__main__":
     a, b, limit = sys.argv[1], sys.argv[2], int(sys.argv[3])
@@ -35,9 +33,9 @@ if __name__ == "__main__":
             u.step(torch.zeros(1, u.action_space.shape[-1]))
             pos, quat = u.sensor.poses()  # [1, bodies, 3/4]: the hand frame, the contact links, the object
             rel = quat_apply(quat_inv(quat[0, 0])[None].expand(n, 4), pos[0, 1:1 + n] - pos[0, 0])
-            touch = u.link_force[0] > 1e-3
-            ia = [i for i in FINGERS[a] if touch[i]]
-            ib = [i for i in FINGERS[b] if touch[i]]
+            touch, fingers = u.link_force[0] > 1e-3, contact_link_fingers(u)
+            ia = [i for i, f in enumerate(fingers) if f == a and touch[i]]
+            ib = [i for i, f in enumerate(fingers) if f == b and touch[i]]
             if ia and ib:
                 d = rel[ib].mean(0) - rel[ia].mean(0)
                 dirs.append(d / d.norm())
