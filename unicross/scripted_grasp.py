@@ -156,6 +156,15 @@ def contact_link_fingers(u) -> List[str]:
     return out
 
 
+def fingers_touching(u, fingers: Sequence[str], env: int = 0) -> Tuple[str, ...]:
+    """The fingers (and ``"palm"``) of env ``env`` of the task ``u`` whose contact links press on the object
+    (net contact force above the task's ``contact_force_threshold``), in contact-link order; ``fingers`` is
+    :func:`contact_link_fingers` of ``u``."""
+    touch = (u.link_force[env] > u.cfg["contact_force_threshold"]).tolist()
+    touched = {f for t, f in zip(touch, fingers) if t}
+    return tuple(f for f in dict.fromkeys(fingers) if f in touched)
+
+
 def hold_test(hand: str, grasps: GraspSet, objects: Sequence[ObjectSpec], seconds: float = 2.0,
               seed: int = 0, randomize: bool = False) -> Tuple[List[bool], List[Tuple[str, ...]]]:
     """Restore each grasp in UniCross-Relocate-v1 with the final pose equal to the start (the wrist
@@ -188,9 +197,7 @@ def hold_test(hand: str, grasps: GraspSet, objects: Sequence[ObjectSpec], second
                 _, _, _, _, info = u.step(zero)
             held[row] = bool((~info["ever_dropped"]).item())
             if held[row]:
-                touch = (u.link_force[0] > u.cfg["contact_force_threshold"]).tolist()
-                touched = {f for t, f in zip(touch, fingers) if t}
-                touching[row] = tuple(f for f in dict.fromkeys(fingers) if f in touched)  # in link order
+                touching[row] = fingers_touching(u, fingers)
         env.close()
     return held, touching
 

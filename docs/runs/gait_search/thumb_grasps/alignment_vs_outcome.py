@@ -6,33 +6,28 @@ outcome; trials split into thirds by |y| of that direction:
 
     python docs/runs/gait_search/thumb_grasps/alignment_vs_outcome.py y- > alignment_y-.txt
 """
+import os
 import sys
 from concurrent.futures import ProcessPoolExecutor
 
 import torch
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))  # pinch_axis.py beside this file
 
 
 def shard_trials(axis, shard):
     torch.set_num_threads(1)
     import unicross  # noqa: F401
     from unicross import evaluation as E
-    from unicross.geometry import quat_apply, quat_inv
     from unicross.objects import get_object_set
-    from unicross.scripted_grasp import contact_link_fingers
+    from pinch_axis import pinch_direction
     act = E.resolve_policy(f"gait:allegro/rotate_{axis}", "allegro")[0]
     pinch = []
 
     def policy(obs, u):
         if int(u.elapsed_steps[0]) == 1:
-            fingers = contact_link_fingers(u)
-            n = len(fingers)
-            pos, quat = u.sensor.poses()
-            rel = quat_apply(quat_inv(quat[0, 0])[None].expand(n, 4), pos[0, 1:1 + n] - pos[0, 0])
-            touch = u.link_force[0] > 1e-3
-            ia = [i for i, f in enumerate(fingers) if f == "index" and touch[i]]
-            ib = [i for i, f in enumerate(fingers) if f == "ring" and touch[i]]
-            d = rel[ib].mean(0) - rel[ia].mean(0) if ia and ib else None
-            pinch.append(None if d is None else (d / d.norm()).tolist())
+            d = pinch_direction(u, "index", "ring")
+            pinch.append(None if d is None else d.tolist())
         return act(obs, u)
 
     out = E.run_protocol("rotate", policy, get_object_set("train", limit=20), trials_per_object=3, seed=0,

@@ -18,6 +18,23 @@ from unicross.geometry import quat_apply, quat_inv
 from unicross.objects import get_object_set
 from unicross.scripted_grasp import contact_link_fingers
 
+
+def pinch_direction(u, a: str, b: str):
+    """Unit vector [3] in the hand frame from the mean position of finger ``a``'s links touching the object
+    (net force > 1 mN) to finger ``b``'s, env 0 of the task ``u``; None unless both touch."""
+    fingers = contact_link_fingers(u)
+    n = len(fingers)
+    pos, quat = u.sensor.poses()  # [1, bodies, 3/4]: the hand frame, the contact links, the object
+    rel = quat_apply(quat_inv(quat[0, 0])[None].expand(n, 4), pos[0, 1:1 + n] - pos[0, 0])
+    touch = u.link_force[0] > 1e-3
+    ia = [i for i, f in enumerate(fingers) if f == a and touch[i]]
+    ib = [i for i, f in enumerate(fingers) if f == b and touch[i]]
+    if not (ia and ib):
+        return None
+    d = rel[ib].mean(0) - rel[ia].mean(0)
+    return d / d.norm()
+
+
 if __name__ == "__main__":
     a, b, limit = sys.argv[1], sys.argv[2], int(sys.argv[3])
     grasps = sys.argv[4] if len(sys.argv) > 4 else None
@@ -27,18 +44,12 @@ if __name__ == "__main__":
                        hand="allegro", objects=[obj], randomize=False, axis="z+",
                        **({"grasp_dataset": grasps} if grasps else {}))
         u = env.unwrapped
-        n = len(u.hand_spec.contact_links)
         for seed in range(3):
             u.reset(seed=seed)
             u.step(torch.zeros(1, u.action_space.shape[-1]))
-            pos, quat = u.sensor.poses()  # [1, bodies, 3/4]: the hand frame, the contact links, the object
-            rel = quat_apply(quat_inv(quat[0, 0])[None].expand(n, 4), pos[0, 1:1 + n] - pos[0, 0])
-            touch, fingers = u.link_force[0] > 1e-3, contact_link_fingers(u)
-            ia = [i for i, f in enumerate(fingers) if f == a and touch[i]]
-            ib = [i for i, f in enumerate(fingers) if f == b and touch[i]]
-            if ia and ib:
-                d = rel[ib].mean(0) - rel[ia].mean(0)
-                dirs.append(d / d.norm())
+            d = pinch_direction(u, a, b)
+            if d is not None:
+                dirs.append(d)
         env.close()
     d = torch.stack(dirs)
     print(f"{a} -> {b}, grasps {grasps or 'shipped'}: {len(d)} starts with both touching; "

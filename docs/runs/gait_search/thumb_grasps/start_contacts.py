@@ -19,15 +19,13 @@ def shard_trials(protocol, axis, objs, limit, spec, grasps, shard):
     import unicross  # noqa: F401
     from unicross import evaluation as E
     from unicross.objects import get_object_set
-    from unicross.scripted_grasp import contact_link_fingers
+    from unicross.scripted_grasp import contact_link_fingers, fingers_touching
     act = E.resolve_policy(spec, "allegro")[0]
     touching = []
 
     def policy(obs, u):
         if int(u.elapsed_steps[0]) == 1:  # the forces of the first control step (the reset reads none)
-            fingers = contact_link_fingers(u)
-            touched = {f for f, t in zip(fingers, (u.link_force[0] > 1e-3).tolist()) if t}
-            touching.append(tuple(f for f in dict.fromkeys(fingers) if f in touched))
+            touching.append(fingers_touching(u, contact_link_fingers(u)))
         return act(obs, u)
 
     out = E.run_protocol(protocol, policy, get_object_set(objs, limit=limit), trials_per_object=3, seed=0,
