@@ -96,10 +96,12 @@ def test_dagger_resume(tmp_path, experts):
     assert ck["replay_dir"] == "replay-000002" and [p.name for p in (tmp_path / "run").glob("replay*")] == ["replay-000002"]
     with pytest.raises(ValueError, match="unicross distill --resume"):
         PPOTrainer(tmp_path / "run", resume=True, progress=False)
-    r = DAggerTrainer(tmp_path / "run", resume=True, progress=False)
+    r = DAggerTrainer(tmp_path / "run", resume=True, progress=False, overrides=dict(optim=dict(lr=1.0e-4)))
     assert r.epoch == 2 and len(r.rb) == n
     for k, s in opt["state"].items():
         assert torch.equal(s["exp_avg"], r.optim.state_dict()["state"][k]["exp_avg"])
+    # a learning rate given on resume is the one the optimiser steps with (its saved state holds the old one)
+    assert all(g["lr"] == 1.0e-4 for g in r.optim.param_groups)
     r.train(epochs=1)
     assert r.epoch == 3
     r.close()
