@@ -21,13 +21,14 @@ import torch
 
 import unicross  # noqa: F401
 from unicross import formulation as F
-from unicross.evaluation import resolve_policy, trial_seed
+from unicross.evaluation import trial_seed
 from unicross.geometry import quat_apply
 from unicross.objects import get_object_set
 from unicross.scripted_grasp import contact_link_fingers, fingers_touching
 
+from handoff_probe import SPECS, phase_policies  # this folder's probe (the script's folder is on sys.path)
+
 EX, EZ = torch.tensor([1.0, 0.0, 0.0]), torch.tensor([0.0, 0.0, 1.0])
-SPECS = {"student": "allegro/student", "experts": "experts:allegro"}
 FINGERS = ("index", "middle", "ring", "thumb")
 
 
@@ -37,8 +38,7 @@ def med(v):
 
 if __name__ == "__main__":
     roles, limit = sys.argv[1:3], int(sys.argv[3])
-    loaded = {r: resolve_policy(SPECS[r], "allegro")[0] for r in set(roles) | {"experts"}}
-    by_mode = {F.MODES.index(m): loaded[r] for m, r in zip(("grasp", "relocate", "translate_z-"), roles + ["experts"])}
+    by_mode = phase_policies(roles + ["experts"])
     relocate, translate = F.MODES.index("relocate"), F.MODES.index("translate_z-")
     rows = []
     for oi, obj in enumerate(get_object_set("test-elongated", limit=limit)):

@@ -26,16 +26,22 @@ SPECS = {"student": "allegro/student", "experts": "experts:allegro", "zero": "ze
          # the scripted relay the shipped translate z- expert is a clone of (translate phase only)
          "relay": "seq:index:2:0.1:0:1000+ring:2:0.05:@index:0.9+middle:2:0.05:@ring:0.9"}
 
-if __name__ == "__main__":
-    roles, limit = sys.argv[1:4], int(sys.argv[4])
-    if len(sys.argv) > 5:  # another student checkpoint
-        SPECS["student"] = sys.argv[5]
+def phase_policies(roles):
+    """mode index -> policy for the chain's grasp, relocate and translate z- phases, ``roles`` naming who acts in each
+    (a key of SPECS or MIXED)."""
     loaded = {r: resolve_policy(SPECS[r], "allegro")[0] for r in set(roles) & set(SPECS)}
     for mixed, (wrist, fingers) in MIXED.items():
         if mixed in roles:
             w, f = (resolve_policy(SPECS[r], "allegro")[0] for r in (wrist, fingers))
             loaded[mixed] = lambda obs, u, w=w, f=f: torch.cat([w(obs, u)[:, :6], f(obs, u)[:, 6:]], -1)
-    by_mode = {F.MODES.index(m): loaded[r] for m, r in zip(("grasp", "relocate", "translate_z-"), roles)}
+    return {F.MODES.index(m): loaded[r] for m, r in zip(("grasp", "relocate", "translate_z-"), roles)}
+
+
+if __name__ == "__main__":
+    roles, limit = sys.argv[1:4], int(sys.argv[4])
+    if len(sys.argv) > 5:  # another student checkpoint
+        SPECS["student"] = sys.argv[5]
+    by_mode = phase_policies(roles)
 
     def policy(obs, u):
         return by_mode[int(u.mode[0])](obs, u)
