@@ -81,7 +81,7 @@ def test_tiny_dagger_lowers_action_mse_on_every_mode(tmp_path, experts):
     t.close()
 
 
-def test_dagger_resume(tmp_path, experts):
+def test_dagger_resume(tmp_path, experts, capsys):
     cfg = dict(env=dict(num_envs=1, object_limit=1, reconfiguration_freq=0, randomize=False,
                         task_config=dict(episode_length=SHORT)),
                collector=dict(rollout_steps=4), optim=dict(batch_size=8, grad_steps=2, epochs=2),
@@ -102,6 +102,7 @@ def test_dagger_resume(tmp_path, experts):
         assert torch.equal(s["exp_avg"], r.optim.state_dict()["state"][k]["exp_avg"])
     # a learning rate given on resume is the one the optimiser steps with (its saved state holds the old one)
     assert all(g["lr"] == 1.0e-4 for g in r.optim.param_groups)
+    assert "resumed with optim.lr=0.0001 (was 0.0003)" in capsys.readouterr().out
     r.train(epochs=1)
     assert r.epoch == 3
     r.close()

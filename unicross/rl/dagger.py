@@ -172,8 +172,11 @@ class DAggerTrainer(Runner):
     def _load(self, ck):
         self.student.load_state_dict(ck["policy"])
         self.optim.load_state_dict(ck["optim"])
+        lr, was = self.cfg["optim"]["lr"], ck["config"]["optim"]["lr"]
         for g in self.optim.param_groups:  # the saved state carries the old rate: a resumed run takes optim.lr
-            g["lr"] = self.cfg["optim"]["lr"]
+            g["lr"] = lr
+        if lr != was:
+            print(f"[unicross] resumed with optim.lr={lr:g} (was {was:g})")
         self.epoch, self.frames = ck["epoch"], ck["frames"]
         self.load_runner_state(ck)
         replay = self.run_dir / ck.get("replay_dir", "replay")  # "replay": checkpoints before named buffers
