@@ -10,7 +10,7 @@ hand, the hand's z against the world's up; over the relocate phase, how far each
 position, rad: the PD squeeze); then the translate phase's outcome. Prints the in-hand success by finger set, and the
 medians of the commands' motion and lead by outcome:
 
-    python docs/runs/experts_chain/handoff/handoff_fingers.py experts student 20 > docs/runs/experts_chain/handoff/fingers_E_S.txt
+    python docs/runs/experts_chain/handoff/handoff_fingers.py experts student 20 > docs/runs/experts_chain/handoff/fingers_E_student.txt
 """
 import collections
 import json
