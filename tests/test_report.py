@@ -57,6 +57,13 @@ def test_report_paper_one_trial(tmp_path):
     assert f"| relocate | zero | {_cell(E.summarize('relocate', trials), 'relocate')} |" in text
     for mode in ("rotate_x+", "rotate_z-", "translate_z+", "translate_z-"):  # the bar of each in-hand expert
         assert f"| {mode} | zero | " in text
+    if "student" in ships:  # the paper's unseen and disturbance rows are its student's: ours has them too
+        for title in ("## Unseen objects", "## Disturbances"):
+            section = text.split(title, 1)[1].split("\n## ", 1)[0]
+            assert "| grasp | allegro/grasp | " in section and "| grasp | allegro/student | " in section
+        objs, _ = E.protocol_objects("grasp", get_object_set("unseen", limit=1), "allegro")
+        trials = E.run_protocol_workers("grasp", "allegro/student", objs, trials_per_object=1, seed=0, progress=False)
+        assert f"| grasp | allegro/student | {_cell(E.summarize('grasp', trials), 'grasp')} |" in text.split("## Unseen", 1)[1].split("\n## ", 1)[0]
     n_rot = sum(m.startswith("rotate") for m in ships)
     if n_rot:  # the issue's rotate target is read off one pooled line under the experts' table
         assert f"Rotate, pooled over the {n_rot} axes with an expert (of 6): " in text

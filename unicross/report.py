@@ -205,13 +205,11 @@ class PaperReport:
             lines += self._rotate_pooled([(m, self.ckpts["student"], "test", False) for m in self.student_modes],
                                          "a distilled student", "Ours")
         self.log("unseen objects ...")
-        lines += self._table("Unseen objects (spheres, hexagonal and octagonal prisms)",
-                             self._per_mode("unseen", False, "expert"), "Uns.",
-                             "The experts (the paper reports its student here). In-hand protocols start from "
-                             "the grasp-state dataset, so they run on the unseen objects that have a grasp.")
+        lines += self._robustness_table("Unseen objects (spheres, hexagonal and octagonal prisms)", "unseen", False,
+                                        "Uns.", "In-hand protocols start from the grasp-state dataset, so they run "
+                                        "on the unseen objects that have a grasp.")
         self.log("disturbances ...")
-        lines += self._table("Disturbances (`--disturb`)", self._per_mode("test", True, "expert"), "Dis.",
-                             "The experts (the paper reports its student here).")
+        lines += self._robustness_table("Disturbances (`--disturb`)", "test", True, "Dis.")
         if self.gaits:
             self.log("scripted gaits ...")
             lines += self._gait_tables()
@@ -233,6 +231,19 @@ class PaperReport:
         else:
             lines += self._long_horizon()
         return "\n".join(lines)
+
+    def _robustness_table(self, title: str, objects: str, disturb: bool, setting: str, note: str = "") -> List[str]:
+        """The paper's generalisation and robustness cells (``objects``, ``disturb``): the experts, then
+        the student (the paper's own rows here are its student's), each with its rotate pool."""
+        rows = self._per_mode(objects, disturb, "expert") + self._per_mode(objects, disturb, "student")
+        lines = self._table(title, rows, setting, " ".join(
+            ["The experts, then the student (the paper column is the paper's student)."] + ([note] if note else [])))
+        lines += self._rotate_pooled([(m, spec, objects, disturb) for m, spec in self.ckpts.items() if m != "student"],
+                                     "an expert", setting)
+        if "student" in self.ckpts:
+            lines += self._rotate_pooled([(m, self.ckpts["student"], objects, disturb) for m in self.student_modes],
+                                         "a distilled student", setting)
+        return lines
 
     def _gait_tables(self) -> List[str]:
         """The shipped scripted gaits (:mod:`unicross.gaits`) on test and unseen objects, and the
