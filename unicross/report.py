@@ -197,13 +197,10 @@ class PaperReport:
                  f"(`configs/eval.yaml`). Paper values: the full test set x 25 trials.", ""]
         self.log("experts on test objects ...")
         lines += self._table("Experts, held-out test objects", self._per_mode("test", False, "expert"), "Experts")
-        lines += self._rotate_pooled([(m, spec, "test", False) for m, spec in self.ckpts.items() if m != "student"],
-                                     "an expert", "Experts")
+        lines += self._experts_pooled("test", False, "Experts")
         self.log("student on test objects ...")
         lines += self._table("Student, held-out test objects", self._per_mode("test", False, "student"), "Ours")
-        if "student" in self.ckpts:
-            lines += self._rotate_pooled([(m, self.ckpts["student"], "test", False) for m in self.student_modes],
-                                         "a distilled student", "Ours")
+        lines += self._student_pooled("test", False, "Ours")
         self.log("unseen objects ...")
         lines += self._robustness_table("Unseen objects (spheres, hexagonal and octagonal prisms)", "unseen", False,
                                         "Uns.", "In-hand protocols start from the grasp-state dataset, so they run "
@@ -238,12 +235,19 @@ class PaperReport:
         rows = self._per_mode(objects, disturb, "expert") + self._per_mode(objects, disturb, "student")
         lines = self._table(title, rows, setting, " ".join(
             ["The experts, then the student (the paper column is the paper's student)."] + ([note] if note else [])))
-        lines += self._rotate_pooled([(m, spec, objects, disturb) for m, spec in self.ckpts.items() if m != "student"],
-                                     "an expert", setting)
-        if "student" in self.ckpts:
-            lines += self._rotate_pooled([(m, self.ckpts["student"], objects, disturb) for m in self.student_modes],
-                                         "a distilled student", setting)
-        return lines
+        return lines + self._experts_pooled(objects, disturb, setting) + self._student_pooled(objects, disturb, setting)
+
+    def _experts_pooled(self, objects: str, disturb: bool, setting: str) -> List[str]:
+        """The shipped experts' rotate cells on ``objects`` pooled (:meth:`_rotate_pooled`)."""
+        return self._rotate_pooled([(m, spec, objects, disturb) for m, spec in self.ckpts.items() if m != "student"],
+                                   "an expert", setting)
+
+    def _student_pooled(self, objects: str, disturb: bool, setting: str) -> List[str]:
+        """The student's rotate cells on ``objects`` pooled; nothing when no student is shipped."""
+        if "student" not in self.ckpts:
+            return []
+        return self._rotate_pooled([(m, self.ckpts["student"], objects, disturb) for m in self.student_modes],
+                                   "a distilled student", setting)
 
     def _gait_tables(self) -> List[str]:
         """The shipped scripted gaits (:mod:`unicross.gaits`) on test and unseen objects, and the
