@@ -72,8 +72,10 @@ def _compare(task, kw, grasp_file):
     eager_state = dict(vars(u))
     vars(u).update(saved)
     u._closest_kinds = frozenset(range(4))  # as when compiling: every primitive's formula, selected per env
-    info, out = GraphMethod(u, type(u)._step_math_eager)(*reads, u.elapsed_steps, noise)
+    gm = GraphMethod(u, type(u)._step_math_eager)
+    info, out = gm(*reads, u.elapsed_steps, noise)
     assert info.keys() == eager_info.keys()
+    assert [g.compiled.__name__ for gs in gm._graphs.values() for g in gs] == ["direct"]  # without AOT's wrappers
     for name, got, want in zip(("obs", "reward", "terminated", "truncated"), out, eager_out):
         torch.testing.assert_close(got, want, atol=1e-5, rtol=1e-5, msg=lambda m: f"{task} {name}: {m}")
     for k, v in eager_info.items():
@@ -175,7 +177,29 @@ def test_graph_method_matches_eager_and_writes_state():
         assert type(toy.rel).__name__ == "Relational"
     g = toy.math._graphs[("add", (False,))][0]
     assert "unused" not in [n for n, _ in g.inputs] and "x" in [n for n, _ in g.inputs]
+    assert g.compiled.__name__ == "direct"  # Inductor's graph without AOTAutograd's wrappers
     assert toy.math._count == 1  # one trace for three calls
+
+
+def test_direct_call_only_where_it_is_the_same_function():
+    from unicross.compiling import _direct
+
+    class Inner:
+        def __init__(self, fn):
+            self.current_callable = fn
+
+    x = torch.arange(3.0)
+    wrapped = lambda t: [t * 2.0, t + 1.0]  # noqa: E731
+    same = Inner(lambda ins: [ins[1] * 2.0, ins[1] + 1.0])  # one lifted constant first, then the input
+    assert _direct(wrapped, [(same, 2)], [torch.zeros(1)], [x]).__name__ == "direct"
+    assert _direct(wrapped, [(same, 2)], [torch.zeros(1)], [x])(x)[1].tolist() == [1.0, 2.0, 3.0]
+    assert _direct(wrapped, [], [], [x]) is wrapped                                      # no inner graph seen
+    assert _direct(wrapped, [(same, 2), (same, 2)], [torch.zeros(1)], [x]) is wrapped    # two graphs
+    assert _direct(wrapped, [(same, 3)], [torch.zeros(1)], [x]) is wrapped               # other inputs
+    other = Inner(lambda ins: [ins[1] * 2.0, ins[1] + 2.0])
+    assert _direct(wrapped, [(other, 2)], [torch.zeros(1)], [x]) is wrapped              # other outputs
+    layout = Inner(lambda ins: [ins[1] * 2.0, (ins[1] + 1.0).view(3, 1)])
+    assert _direct(wrapped, [(layout, 2)], [torch.zeros(1)], [x]) is wrapped             # another layout
 
 
 def test_graph_method_specialises_on_shapes_keys_and_missing_arguments():
