@@ -517,7 +517,7 @@ class _inner_graphs:
 
 def _direct(wrapped: Callable, inner: list, lifted: list, example: list) -> Callable:
     """Inductor's compiled graph called directly (``current_callable`` on a list of the inputs), without
-    AOTAutograd's runtime wrappers and ``CompiledFxGraph.__call__``'s per-call bookkeeping (~4% of a
+    AOTAutograd's runtime wrappers and ``CompiledFxGraph.__call__``'s per-call bookkeeping (1-5% of a
     whole task step on the CPU, measured in one process), when that is the same function: one inner
     graph whose inputs are the graph module's ``lifted`` parameters and buffers (AOTAutograd passes them
     first) and then exactly the inputs given, and which returns the wrapped call's outputs, bit for bit
