@@ -10,18 +10,12 @@ import gzip
 import json
 import math
 
+from unicross.metrics import wilson_interval as wilson
+
 
 def load(path):
     with (gzip.open(path, "rt") if path.endswith(".gz") else open(path)) as f:
         return json.load(f)
-
-
-def wilson(k, n, z=1.959964):
-    p = k / n
-    d = 1 + z * z / n
-    c = (p + z * z / (2 * n)) / d
-    h = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / d
-    return c - h, c + h
 
 
 def mcnemar_exact(b, c):
@@ -33,7 +27,7 @@ def mcnemar_exact(b, c):
     return min(1.0, 2 * tail)
 
 
-def newcombe_paired(a, b, c, d, z=1.959964):
+def newcombe_paired(a, b, c, d, z=1.96):
     """95% interval of p1 - p2 for paired proportions (Newcombe 1998, method 10): a both succeed, b only
     the first, c only the second, d neither."""
     n = a + b + c + d
