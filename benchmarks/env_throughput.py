@@ -42,6 +42,15 @@ TASKS = [("UniCross-Grasp-v1", {}), ("UniCross-Relocate-v1", {}), ("UniCross-Rot
          ("UniCross-Translate-v1", {"direction": "z+"}), ("UniCross-MultiSkill-v1", {})]
 
 
+def held_objects(hand: str = "allegro"):
+    """(scripted grasps, objects): one training object per group and a scripted grasp of each, keeping the
+    objects that have one (in-hand tasks start from a grasp of each object)."""
+    objects = get_object_set("train", limit=1)
+    gs, _ = synthesize(hand, objects, per_object=1, seed=0, progress=False)
+    have = {n for n, c in gs.counts().items() if c}
+    return gs, [o for o in objects if o.name in have]
+
+
 def _holding_env(task, kw, grasps, objects, hand="allegro", **extra):
     env = gym.make(task, obs_mode="state", sim_backend="physx_cpu", render_backend="none", objects=objects, hand=hand,
                    grasp_dataset=grasps, randomize=False, config=dict(grasp=dict(lift_after=None)), **kw, **extra)
@@ -132,10 +141,7 @@ def main():
     p.add_argument("--tasks", nargs="+", choices=[t for t, _ in TASKS], default=[t for t, _ in TASKS])
     args = p.parse_args()
     torch.set_num_threads(1)
-    objects = get_object_set("train", limit=1)
-    gs, _ = synthesize(args.hand, objects, per_object=1, seed=0, progress=False)
-    have = {n for n, c in gs.counts().items() if c}
-    objects = [o for o in objects if o.name in have]  # in-hand tasks start from a grasp of each object
+    gs, objects = held_objects(args.hand)
     print(f"hand {args.hand}: {len(objects)} objects with a scripted grasp")
     rows = []
     for task, kw in TASKS:

@@ -33,10 +33,8 @@ import torch
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from env_throughput import _holding_env  # noqa: E402
+from env_throughput import _holding_env, held_objects  # noqa: E402
 from unicross.compiling import GraphMethod  # noqa: E402
-from unicross.objects import get_object_set  # noqa: E402
-from unicross.scripted_grasp import synthesize  # noqa: E402
 
 _REVOLUTE = ("revolute", "revolute_unwrapped")
 
@@ -194,10 +192,7 @@ def main():
     p.add_argument("--json", default=None)
     args = p.parse_args()
     torch.set_num_threads(1)
-    objects = get_object_set("train", limit=1)
-    gs, _ = synthesize(args.hand, objects, per_object=1, seed=0, progress=False)
-    have = {n for n, c in gs.counts().items() if c}
-    objects = [o for o in objects if o.name in have]
+    gs, objects = held_objects(args.hand)
     env, u = _holding_env("UniCross-Rotate-v1", {"axis": "z+"}, gs, objects, hand=args.hand)
     g = torch.Generator().manual_seed(0)
     for _ in range(20):  # a holding hand with its joints away from zero

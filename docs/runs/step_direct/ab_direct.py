@@ -43,10 +43,7 @@ def main():
     p.add_argument("--json", default=None)
     args = p.parse_args()
     torch.set_num_threads(1)
-    objects = et.get_object_set("train", limit=1)
-    gs, _ = et.synthesize("allegro", objects, per_object=1, seed=0, progress=False)
-    have = {n for n, c in gs.counts().items() if c}
-    objects = [o for o in objects if o.name in have]
+    gs, objects = et.held_objects()
     rows = []
     for task in args.tasks:
         kw = dict(et.TASKS)[task]
