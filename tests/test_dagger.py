@@ -154,3 +154,38 @@ def test_dagger_on_ray_env_actors_fills_the_buffer_local_workers_fill(tmp_path, 
     a, b = local.rb[:], on_ray.rb[:]
     for k in ("hand", "object", "goal", "expert_action", "mode"):
         assert torch.equal(a[k], b[k]), k
+
+
+def test_dagger_starts_from_a_student_and_learns_around_its_states(tmp_path, experts):
+    """model.init_policy starts the student from another student's weights and statistics (a
+    policy of another skill is refused before any worker starts); optim.label_noise perturbs the
+    hand and object observations of a share of each batch, leaves the goal (the teacher's key) as
+    it is, and the update reports the error on those rows apart."""
+    cfg = dict(env=dict(num_envs=1, object_limit=1, reconfiguration_freq=0, randomize=False,
+                        task_config=dict(episode_length=SHORT)),
+               collector=dict(rollout_steps=4), optim=dict(batch_size=8, grad_steps=2, epochs=2),
+               buffer=dict(capacity=100), logging=dict(checkpoint_every=1))
+    first = DAggerTrainer(tmp_path / "first", experts, overrides=cfg, progress=False)
+    first.train()
+    first.close()
+    with pytest.raises(ValueError, match="acts for skill/axis/hand"):
+        DAggerTrainer(tmp_path / "wrong", experts, progress=False,
+                      overrides=dict(cfg, model=dict(init_policy=str(experts / "grasp" / "checkpoint.pt"))))
+    noisy = dict(cfg, optim=dict(cfg["optim"], label_noise=0.5, label_noise_share=0.5),
+                 model=dict(init_policy=str(tmp_path / "first" / "checkpoint.pt")))
+    t = DAggerTrainer(tmp_path / "second", experts, overrides=noisy, progress=False)
+    try:
+        theirs = first.student.state_dict()
+        assert all(torch.equal(v, theirs[k]) for k, v in t.student.state_dict().items())
+        t.collect()
+        b = t.rb.sample()
+        obs = b.select("hand", "object", "goal").clone()
+        k = t._perturb(obs, 0.5, 0.5)
+        assert k == 4
+        for key in ("hand", "object"):
+            assert not torch.equal(obs[key][:k], b[key][:k]) and torch.equal(obs[key][k:], b[key][k:])
+        assert torch.equal(obs["goal"], b["goal"])
+        upd = t.update()
+        assert {"loss", "mse", "mse_perturbed"} <= set(upd) and upd["mse_perturbed"] > 0
+    finally:
+        t.close()

@@ -32,6 +32,7 @@ from unicross.grasps import grasp_dataset_file
 from unicross.rl.collector import check_overlap, make_collector, resolve_num_envs
 from unicross.rl.models import OBS_KEYS, make_models
 from unicross.rl.policy_io import base_policy_of, load_policy
+from unicross.rl.ppo import adopt_input_floor, policy_to_start_from
 from unicross.rl.runner import CKPT_NAME, Runner, atomic_save
 
 
@@ -120,6 +121,10 @@ class DAggerTrainer(Runner):
         self.share_cores(ec["backend"])
         self.teachers = Teachers(paths, self.device)
         kw["hand"] = self.teachers.hand
+        start = None  # model.init_policy: read and checked before any worker starts
+        if self.ckpt is None and cfg["model"].get("init_policy"):
+            start = policy_to_start_from(cfg["model"]["init_policy"], "multi", None, self.teachers.hand)
+            adopt_input_floor(cfg["model"], start)
         self.env_kwargs = kw
         # the student acts (its mean action) in worker processes with shared weights (lean collector),
         # or in Ray env actors (collector.ray_address)
@@ -133,6 +138,12 @@ class DAggerTrainer(Runner):
         self.dims, self.n_act = self.collector.dims, self.collector.n_act
         self.student, _, self.norm = make_models(self.dims, self.n_act, Bounded(-1.0, 1.0, (self.n_act,)),
                                                  cfg["model"])
+        if start is not None:
+            if dict(start["obs_dims"]) != dict(self.dims) or int(start["n_act"]) != self.n_act:
+                raise ValueError(f"model.init_policy={cfg['model']['init_policy']}: observation sizes "
+                                 f"{start['obs_dims']} and {start['n_act']} actions, this run has {self.dims} and "
+                                 f"{self.n_act}")
+            self.student.load_state_dict(start["policy"])  # weights and observation statistics
         self.student.to(self.device)
         self.actor = self.student.module[0]  # hand/object/goal -> loc, scale
         self.optim = torch.optim.Adam(self.actor.parameters(), lr=cfg["optim"]["lr"])
@@ -210,26 +221,55 @@ class DAggerTrainer(Runner):
         return stats
 
     def update(self) -> dict:
-        """``grad_steps`` MSE steps on replay batches; returns the mean loss and per-mode MSE."""
+        """``grad_steps`` MSE steps on replay batches. Returns the mean loss, and the MSE overall and per
+        mode on the batches' stored states (with ``optim.label_noise``: on the rows left as stored, and
+        ``mse_perturbed`` on the others)."""
         oc = self.cfg["optim"]
-        total, per_mode, counts = 0.0, torch.zeros(F.NUM_MODES), torch.zeros(F.NUM_MODES)
+        noise = float(oc.get("label_noise") or 0.0)
+        total, clean, noisy = 0.0, 0.0, 0.0
+        per_mode, counts = torch.zeros(F.NUM_MODES), torch.zeros(F.NUM_MODES)
         for _ in range(oc["grad_steps"]):
             b = self.rb.sample()
-            pred = self.actor(b.select(*OBS_KEYS).clone())["loc"]
-            err = ((pred - b["expert_action"]) ** 2).mean(-1)
+            obs, target = b.select(*OBS_KEYS).clone(), b["expert_action"]
+            k = self._perturb(obs, noise, float(oc.get("label_noise_share", 0.5))) if noise > 0 else 0
+            if k:
+                target = torch.cat([self.teachers(obs[:k]), target[k:]])
+            pred = self.actor(obs)["loc"]
+            err = ((pred - target) ** 2).mean(-1)
             loss = err.mean()
             self.optim.zero_grad(set_to_none=True)
             loss.backward()
             self.optim.step()
             total += float(loss.detach())
             with torch.no_grad():
-                per_mode.index_add_(0, b["mode"].cpu(), err.detach().cpu())
-                counts.index_add_(0, b["mode"].cpu(), torch.ones_like(err).cpu())
-        out = {"mse": total / oc["grad_steps"]}
+                e = err.detach()
+                clean += float(e[k:].mean())
+                noisy += float(e[:k].mean()) if k else 0.0
+                per_mode.index_add_(0, b["mode"][k:].cpu(), e[k:].cpu())
+                counts.index_add_(0, b["mode"][k:].cpu(), torch.ones_like(e[k:]).cpu())
+        steps = oc["grad_steps"]
+        out = {"loss": total / steps, "mse": clean / steps}
+        if noise > 0:
+            out["mse_perturbed"] = noisy / steps
         for i, m in enumerate(F.MODES):
             if counts[i] > 0:
                 out[f"mse/{m}"] = float(per_mode[i] / counts[i])
         return out
+
+    @torch.no_grad()
+    def _perturb(self, obs: TensorDict, noise: float, share: float) -> int:
+        """Adds Gaussian noise to the hand and object observations of the first ``share`` of the rows of
+        ``obs`` (a random sample, so a random subset), ``noise`` standard deviations of each feature as
+        the student's normaliser divides it (the goal, which routes a row to its teacher, is left as
+        is). Returns the number of rows changed; their labels are the teachers' actions on the changed
+        observations, so the student learns the teachers' answers around the states it visits too."""
+        k = int(round(share * obs.batch_size[0]))
+        n = self.norm
+        for key in ("hand", "object"):
+            std = torch.sqrt(getattr(n, f"{key}_var") + 1e-8).clamp_min(n.std_min)
+            x = obs[key]
+            x[:k] += noise * std * torch.randn_like(x[:k])
+        return k
 
     @torch.no_grad()
     def action_mse(self, td: TensorDict) -> Dict[str, float]:
