@@ -171,7 +171,7 @@ def test_dagger_starts_from_a_student_and_learns_around_its_states(tmp_path, exp
     with pytest.raises(ValueError, match="acts for skill/axis/hand"):
         DAggerTrainer(tmp_path / "wrong", experts, progress=False,
                       overrides=dict(cfg, model=dict(init_policy=str(experts / "grasp" / "checkpoint.pt"))))
-    noisy = dict(cfg, optim=dict(cfg["optim"], label_noise=0.5, label_noise_share=0.5),
+    noisy = dict(cfg, optim=dict(cfg["optim"], label_noise=0.5, label_noise_share=0.5, label_noise_modes=["grasp"]),
                  model=dict(init_policy=str(tmp_path / "first" / "checkpoint.pt")))
     t = DAggerTrainer(tmp_path / "second", experts, overrides=noisy, progress=False)
     try:
@@ -179,12 +179,14 @@ def test_dagger_starts_from_a_student_and_learns_around_its_states(tmp_path, exp
         assert all(torch.equal(v, theirs[k]) for k, v in t.student.state_dict().items())
         t.collect()
         b = t.rb.sample()
+        b["mode"][:] = torch.tensor([0, 1, 0, 1, 0, 1, 0, 1])  # grasp, relocate, ...
         obs = b.select("hand", "object", "goal").clone()
-        k = t._perturb(obs, 0.5, 0.5)
-        assert k == 4
+        moved = t._perturb(obs, b["mode"], 0.5, 0.5)
+        assert moved.tolist() == [True, False, True, False] + [False] * 4  # the first half's grasp rows
         for key in ("hand", "object"):
-            assert not torch.equal(obs[key][:k], b[key][:k]) and torch.equal(obs[key][k:], b[key][k:])
+            assert (obs[key] != b[key]).any(-1).tolist() == moved.tolist()
         assert torch.equal(obs["goal"], b["goal"])
+        t.cfg["optim"]["label_noise_modes"] = None  # every mode (this run's buffer holds one other mode)
         upd = t.update()
         assert {"loss", "mse", "mse_perturbed"} <= set(upd) and upd["mse_perturbed"] > 0
     finally:

@@ -231,9 +231,10 @@ class DAggerTrainer(Runner):
         for _ in range(oc["grad_steps"]):
             b = self.rb.sample()
             obs, target = b.select(*OBS_KEYS).clone(), b["expert_action"]
-            k = self._perturb(obs, noise, float(oc.get("label_noise_share", 0.5))) if noise > 0 else 0
-            if k:
-                target = torch.cat([self.teachers(obs[:k]), target[k:]])
+            moved = self._perturb(obs, b["mode"], noise, float(oc.get("label_noise_share", 0.5))) if noise > 0 else None
+            if moved is not None and bool(moved.any()):
+                target = target.clone()
+                target[moved] = self.teachers(obs[moved])
             pred = self.actor(obs)["loc"]
             err = ((pred - target) ** 2).mean(-1)
             loss = err.mean()
@@ -243,10 +244,11 @@ class DAggerTrainer(Runner):
             total += float(loss.detach())
             with torch.no_grad():
                 e = err.detach()
-                clean += float(e[k:].mean())
-                noisy += float(e[:k].mean()) if k else 0.0
-                per_mode.index_add_(0, b["mode"][k:].cpu(), e[k:].cpu())
-                counts.index_add_(0, b["mode"][k:].cpu(), torch.ones_like(e[k:]).cpu())
+                kept = torch.ones_like(e, dtype=torch.bool) if moved is None else ~moved
+                clean += float(e[kept].mean())
+                noisy += float(e[moved].mean()) if moved is not None and bool(moved.any()) else 0.0
+                per_mode.index_add_(0, b["mode"][kept].cpu(), e[kept].cpu())
+                counts.index_add_(0, b["mode"][kept].cpu(), torch.ones_like(e[kept]).cpu())
         steps = oc["grad_steps"]
         out = {"loss": total / steps, "mse": clean / steps}
         if noise > 0:
@@ -257,19 +259,27 @@ class DAggerTrainer(Runner):
         return out
 
     @torch.no_grad()
-    def _perturb(self, obs: TensorDict, noise: float, share: float) -> int:
-        """Adds Gaussian noise to the hand and object observations of the first ``share`` of the rows of
-        ``obs`` (a random sample, so a random subset), ``noise`` standard deviations of each feature as
-        the student's normaliser divides it (the goal, which routes a row to its teacher, is left as
-        is). Returns the number of rows changed; their labels are the teachers' actions on the changed
-        observations, so the student learns the teachers' answers around the states it visits too."""
-        k = int(round(share * obs.batch_size[0]))
+    def _perturb(self, obs: TensorDict, mode: torch.Tensor, noise: float, share: float) -> torch.Tensor:
+        """Adds Gaussian noise to the hand and object observations of the rows among the first ``share``
+        of ``obs`` (a random sample, so a random subset) whose mode is one of ``optim.label_noise_modes``:
+        ``noise`` standard deviations of each feature as the student's normaliser divides it (the goal,
+        which routes a row to its teacher, is left as is). Returns the mask of the rows changed; their
+        labels become the teachers' actions on the changed observations, so the student learns the
+        teachers' answers around the states it visits too."""
+        moved = torch.zeros(obs.batch_size[0], dtype=torch.bool, device=mode.device)
+        moved[:int(round(share * obs.batch_size[0]))] = True
+        modes = self.cfg["optim"].get("label_noise_modes")
+        if modes is not None:
+            unknown = sorted(set(modes) - set(F.MODES))
+            if unknown:
+                raise ValueError(f"optim.label_noise_modes: unknown mode(s) {unknown}; modes: {list(F.MODES)}")
+            moved &= torch.isin(mode, torch.tensor([F.MODES.index(m) for m in modes], device=mode.device))
         n = self.norm
         for key in ("hand", "object"):
             std = torch.sqrt(getattr(n, f"{key}_var") + 1e-8).clamp_min(n.std_min)
             x = obs[key]
-            x[:k] += noise * std * torch.randn_like(x[:k])
-        return k
+            x[moved] += noise * std * torch.randn_like(x[moved])
+        return moved
 
     @torch.no_grad()
     def action_mse(self, td: TensorDict) -> Dict[str, float]:
