@@ -28,6 +28,14 @@ def experts(tmp_path_factory):
     return root
 
 
+def _tiny_cfg(num_envs=1, grad_steps=2, epochs=2, **collector):
+    """Overrides of a few-step DAgger run on one object (``collector``: more collector fields)."""
+    return dict(env=dict(num_envs=num_envs, object_limit=1, reconfiguration_freq=0, randomize=False,
+                         task_config=dict(episode_length=SHORT)),
+                collector=dict(rollout_steps=4, **collector), optim=dict(batch_size=8, grad_steps=grad_steps, epochs=epochs),
+                buffer=dict(capacity=100), logging=dict(checkpoint_every=1))
+
+
 def _held_out(seed=99):
     """States of every mode from separate rollouts with random actions."""
     tds = []
@@ -82,10 +90,7 @@ def test_tiny_dagger_lowers_action_mse_on_every_mode(tmp_path, experts):
 
 
 def test_dagger_resume(tmp_path, experts, capsys):
-    cfg = dict(env=dict(num_envs=1, object_limit=1, reconfiguration_freq=0, randomize=False,
-                        task_config=dict(episode_length=SHORT)),
-               collector=dict(rollout_steps=4), optim=dict(batch_size=8, grad_steps=2, epochs=2),
-               buffer=dict(capacity=100), logging=dict(checkpoint_every=1))
+    cfg = _tiny_cfg()
     t = DAggerTrainer(tmp_path / "run", experts, overrides=cfg, progress=False)
     t.train()
     opt = t.optim.state_dict()
@@ -111,10 +116,7 @@ def test_dagger_resume(tmp_path, experts, capsys):
 def test_dagger_with_overlapped_rollouts_fills_and_resumes(tmp_path, experts):
     """collector.overlap: two workers roll out the next epoch during the update; every epoch adds
     its rollout to the buffer, the last starts none, and a resumed run goes on."""
-    cfg = dict(env=dict(num_envs=2, object_limit=1, reconfiguration_freq=0, randomize=False,
-                        task_config=dict(episode_length=SHORT)),
-               collector=dict(rollout_steps=4, overlap=True), optim=dict(batch_size=8, grad_steps=2, epochs=2),
-               buffer=dict(capacity=100), logging=dict(checkpoint_every=1))
+    cfg = _tiny_cfg(num_envs=2, overlap=True)
     t = DAggerTrainer(tmp_path / "run", experts, overrides=cfg, progress=False)
     try:
         t.train()
@@ -136,10 +138,7 @@ def test_dagger_on_ray_env_actors_fills_the_buffer_local_workers_fill(tmp_path, 
     """DAgger with collector.ray_address (a loopback Ray cluster) labels the same states as with
     local worker processes: one epoch gives the same replay buffer, bit for bit."""
     ray = pytest.importorskip("ray")
-    cfg = dict(env=dict(num_envs=2, object_limit=1, reconfiguration_freq=0, randomize=False,
-                        task_config=dict(episode_length=SHORT)),
-               collector=dict(rollout_steps=4), optim=dict(batch_size=8, grad_steps=1, epochs=1),
-               buffer=dict(capacity=100), logging=dict(checkpoint_every=1))
+    cfg = _tiny_cfg(num_envs=2, grad_steps=1, epochs=1)
     local = DAggerTrainer(tmp_path / "local", experts, overrides=cfg, progress=False)
     local.train()
     local.close()
@@ -161,10 +160,7 @@ def test_dagger_starts_from_a_student_and_learns_around_its_states(tmp_path, exp
     policy of another skill is refused before any worker starts); optim.label_noise perturbs the
     hand and object observations of a share of each batch, leaves the goal (the teacher's key) as
     it is, and the update reports the error on those rows apart."""
-    cfg = dict(env=dict(num_envs=1, object_limit=1, reconfiguration_freq=0, randomize=False,
-                        task_config=dict(episode_length=SHORT)),
-               collector=dict(rollout_steps=4), optim=dict(batch_size=8, grad_steps=2, epochs=2),
-               buffer=dict(capacity=100), logging=dict(checkpoint_every=1))
+    cfg = _tiny_cfg()
     first = DAggerTrainer(tmp_path / "first", experts, overrides=cfg, progress=False)
     first.train()
     first.close()
