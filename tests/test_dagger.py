@@ -164,6 +164,9 @@ def test_dagger_starts_from_a_student_and_learns_around_its_states(tmp_path, exp
     first = DAggerTrainer(tmp_path / "first", experts, overrides=cfg, progress=False)
     first.train()
     first.close()
+    with pytest.raises(ValueError, match="label_noise_modes: unknown mode"):
+        DAggerTrainer(tmp_path / "typo", experts, progress=False,
+                      overrides=dict(cfg, optim=dict(cfg["optim"], label_noise_modes=["translate_z"])))
     with pytest.raises(ValueError, match="acts for skill/axis/hand"):
         DAggerTrainer(tmp_path / "wrong", experts, progress=False,
                       overrides=dict(cfg, model=dict(init_policy=str(experts / "grasp" / "checkpoint.pt"))))

@@ -121,6 +121,9 @@ class DAggerTrainer(Runner):
         self.share_cores(ec["backend"])
         self.teachers = Teachers(paths, self.device)
         kw["hand"] = self.teachers.hand
+        unknown = sorted(set(cfg["optim"].get("label_noise_modes") or []) - set(F.MODES))
+        if unknown:
+            raise ValueError(f"optim.label_noise_modes: unknown mode(s) {unknown}; modes: {list(F.MODES)}")
         start = None  # model.init_policy: read and checked before any worker starts
         if self.ckpt is None and cfg["model"].get("init_policy"):
             start = policy_to_start_from(cfg["model"]["init_policy"], "multi", None, self.teachers.hand)
@@ -245,7 +248,7 @@ class DAggerTrainer(Runner):
             with torch.no_grad():
                 e = err.detach()
                 kept = torch.ones_like(e, dtype=torch.bool) if moved is None else ~moved
-                clean += float(e[kept].mean())
+                clean += float(e[kept].mean()) if bool(kept.any()) else 0.0
                 noisy += float(e[moved].mean()) if moved is not None and bool(moved.any()) else 0.0
                 per_mode.index_add_(0, b["mode"][kept].cpu(), e[kept].cpu())
                 counts.index_add_(0, b["mode"][kept].cpu(), torch.ones_like(e[kept]).cpu())
@@ -270,9 +273,6 @@ class DAggerTrainer(Runner):
         moved[:int(round(share * obs.batch_size[0]))] = True
         modes = self.cfg["optim"].get("label_noise_modes")
         if modes is not None:
-            unknown = sorted(set(modes) - set(F.MODES))
-            if unknown:
-                raise ValueError(f"optim.label_noise_modes: unknown mode(s) {unknown}; modes: {list(F.MODES)}")
             moved &= torch.isin(mode, torch.tensor([F.MODES.index(m) for m in modes], device=mode.device))
         n = self.norm
         for key in ("hand", "object"):
