@@ -234,8 +234,11 @@ class DAggerTrainer(Runner):
         for _ in range(oc["grad_steps"]):
             b = self.rb.sample()
             obs, target = b.select(*OBS_KEYS).clone(), b["expert_action"]
-            moved = self._perturb(obs, b["mode"], noise, float(oc.get("label_noise_share", 0.5))) if noise > 0 else None
-            if moved is not None and bool(moved.any()):
+            moved = torch.zeros(obs.batch_size[0], dtype=torch.bool, device=target.device)
+            if noise > 0:
+                moved = self._perturb(obs, b["mode"], noise, float(oc.get("label_noise_share", 0.5)))
+            any_moved = bool(moved.any())
+            if any_moved:
                 target = target.clone()
                 target[moved] = self.teachers(obs[moved])
             pred = self.actor(obs)["loc"]
@@ -246,10 +249,9 @@ class DAggerTrainer(Runner):
             self.optim.step()
             total += float(loss.detach())
             with torch.no_grad():
-                e = err.detach()
-                kept = torch.ones_like(e, dtype=torch.bool) if moved is None else ~moved
-                clean += float(e[kept].mean()) if bool(kept.any()) else 0.0
-                noisy += float(e[moved].mean()) if moved is not None and bool(moved.any()) else 0.0
+                e, kept = err.detach(), ~moved
+                clean += float(e[kept].mean()) if not bool(moved.all()) else 0.0
+                noisy += float(e[moved].mean()) if any_moved else 0.0
                 per_mode.index_add_(0, b["mode"][kept].cpu(), e[kept].cpu())
                 counts.index_add_(0, b["mode"][kept].cpu(), torch.ones_like(e[kept]).cpu())
         steps = oc["grad_steps"]
