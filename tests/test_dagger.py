@@ -159,7 +159,8 @@ def test_dagger_starts_from_a_student_and_learns_around_its_states(tmp_path, exp
     """model.init_policy starts the student from another student's weights and statistics (a
     policy of another skill is refused before any worker starts); optim.label_noise perturbs the
     hand and object observations of a share of each batch, leaves the goal (the teacher's key) as
-    it is, and the update reports the error on those rows apart."""
+    it is, and the update reports the error on those rows apart; optim.warmup_frames holds the updates
+    back until the buffer is that full."""
     cfg = _tiny_cfg()
     first = DAggerTrainer(tmp_path / "first", experts, overrides=cfg, progress=False)
     first.train()
@@ -188,5 +189,13 @@ def test_dagger_starts_from_a_student_and_learns_around_its_states(tmp_path, exp
         t.cfg["optim"]["label_noise_modes"] = None  # every mode (this run's buffer holds one other mode)
         upd = t.update()
         assert {"loss", "mse", "mse_perturbed"} <= set(upd) and upd["mse_perturbed"] > 0
+        # optim.warmup_frames: epochs only collect (and log no loss) until the buffer holds that many rows
+        before = {k: v.detach().clone() for k, v in t.actor.named_parameters()}  # statistics keep running
+        n = len(t.rb)
+        t.cfg["optim"]["warmup_frames"] = n + 2 * cfg["collector"]["rollout_steps"]
+        assert "loss" not in t.train(epochs=1) and len(t.rb) > n
+        assert all(torch.equal(v, before[k]) for k, v in t.actor.named_parameters())
+        assert "loss" in t.train(epochs=1)
+        assert not all(torch.equal(v, before[k]) for k, v in t.actor.named_parameters())
     finally:
         t.close()

@@ -5,7 +5,7 @@ of :mod:`unicross.rl.collector`) in ``UniCross-MultiSkill-v1`` (environments spr
 (object, mode) pairs) for ``rollout_steps``; every visited state is labelled by the frozen expert
 of its mode (query rate 100%); the (observation, expert action) pairs go to a TensorDict replay
 buffer (``LazyTensorStorage``, capacity 1e6 by default); the student then takes
-``grad_steps`` MSE steps on sampled batches.
+``grad_steps`` MSE steps on sampled batches (once ``optim.warmup_frames`` rows are stored; 0 by default).
 
 The trainer refuses to start unless every mode of ``env.modes`` (default: all ten) has an expert checkpoint
 (``<experts>/<mode>/checkpoint.pt``, the run directories of ``unicross train``).
@@ -314,7 +314,7 @@ class DAggerTrainer(Runner):
             more = self.epoch + 1 < target
             self.take_update_threads(busy_cores=self.collector.num_envs if self.overlap and more else 0)
             col = self.collect(more=more)
-            upd = self.update()
+            upd = self.update() if len(self.rb) >= int(self.cfg["optim"].get("warmup_frames") or 0) else {}
             self.epoch += 1
             last = dict(epoch=self.epoch, frames=self.frames, wall_s=self._wall(), buffer=len(self.rb),
                         seconds=time.perf_counter() - t0, **upd, **col)
@@ -323,7 +323,7 @@ class DAggerTrainer(Runner):
             if self.epoch % self.cfg["logging"]["checkpoint_every"] == 0:
                 self.save()
             bar.update(1)
-            bar.set_postfix(mse=f"{upd['mse']:.4f}")
+            bar.set_postfix(mse=f"{upd['mse']:.4f}" if upd else "warm-up")
         return last
 
     def close(self):
