@@ -115,7 +115,7 @@ def plot_clone(runs, fig, a, b, args) -> int:
 
 def is_dagger(run: Path) -> bool:
     first = (run / "metrics.jsonl").read_text().split("\n", 1)[0]
-    return '"mse"' in first and '"epoch"' in first
+    return '"buffer"' in first and '"epoch"' in first  # a warm-up epoch (optim.warmup_frames) logs no mse
 
 
 def plot_dagger(runs, fig, a, b, args) -> int:
