@@ -1,4 +1,5 @@
 """TorchRL side: env specs, a tiny PPO run that learns weights, resume after interruption."""
+import gzip
 import signal
 import subprocess
 import sys
@@ -172,10 +173,13 @@ def test_finished_run_evaluates_on_held_out_objects_and_exports(tmp_path):
     r = json.loads((tmp_path / "run" / "final_eval.json").read_text())
     assert r["objects"] == "test" and r["summaries"]["grasp"]["n"] == 4 == summary["final"]["n"]
     out = tmp_path / "ship" / "grasp.pt"
+    gz = tmp_path / "final_eval.json.gz"  # evaluations are committed gzipped
+    gz.write_bytes(gzip.compress((tmp_path / "run" / "final_eval.json").read_bytes()))
     assert main(["export", str(tmp_path / "run"), "--out", str(out), "--command", "unicross train ...",
-                 "--eval", str(tmp_path / "run" / "final_eval.json")]) == 0
+                 "--eval", str(tmp_path / "run" / "final_eval.json"), "--eval", str(gz)]) == 0
     side = json.loads(out.with_suffix(".json").read_text())
     assert side["commands"] == ["unicross train ..."] and side["evaluations"][0]["summaries"]["grasp"]["n"] == 4
+    assert side["evaluations"][1]["summaries"] == side["evaluations"][0]["summaries"]
     policy, ck = load_policy(out)
     assert "optim" not in ck and ck["skill"] == "grasp" and out.stat().st_size < 3e6
 
