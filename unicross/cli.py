@@ -246,9 +246,9 @@ def _stopped(trainer, where: str) -> int:
 
 def _cmd_export(args) -> int:
     """The acting part of a run's checkpoint (policy + observation statistics) and a JSON sidecar."""
-    import platform
-    import gzip
     import os
+    import platform
+    from unicross.evaluation import read_results
     from unicross.rl.policy_io import export_policy
     run = Path(args.run)
     ckpt = run / "checkpoint.pt" if run.is_dir() else run
@@ -263,8 +263,7 @@ def _cmd_export(args) -> int:
     if ck.get("clone_of"):  # benchmarks/gait_clone.py: a network fitted to a scripted gait, not PPO
         sidecar["kind"] = "dagger clone of a scripted gait"
     for f in args.eval or []:
-        raw = Path(f).read_bytes()
-        e = json.loads(gzip.decompress(raw) if f.endswith(".gz") else raw)
+        e = read_results(f)
         sidecar.setdefault("evaluations", []).append(dict(file=str(f), objects=e.get("objects"), limit=e.get("limit"),
                                                           trials_per_object=e.get("trials_per_object"),
                                                           seed=e.get("seed"), summaries=e.get("summaries")))
@@ -412,9 +411,7 @@ def _cmd_report(args) -> int:
         raise ValueError("report needs eval JSON files, or --paper to evaluate the shipped checkpoints")
     rows: dict = {}
     for f in args.files:
-        r = json.loads(Path(f).read_text())
-        if "summaries" not in r:
-            raise ValueError(f"{f} is not a `unicross eval` result")
+        r = E.read_results(f)
         label = r["label"] + (" (Dis.)" if r.get("disturb") else "") + (" (Ori.)" if r.get("original") else "")
         rows.setdefault(label, {}).update(r["summaries"])
     table = E.markdown_table(rows)
@@ -626,7 +623,7 @@ def main(argv=None) -> int:
     s.add_argument("run", help="run directory (or checkpoint.pt)")
     s.add_argument("--out", required=True, help="e.g. unicross/checkpoints/allegro/grasp.pt")
     s.add_argument("--command", action="append", help="a command that produced the run (repeat, in order)")
-    s.add_argument("--eval", action="append", help="an eval JSON written by `unicross eval` to record (.json or .json.gz)")
+    s.add_argument("--eval", action="append", help="an eval result written by `unicross eval` to record (.json or .json.gz)")
     s.set_defaults(fn=_cmd_export)
     s = sub.add_parser("audit", help="reward audit: discounted, scaled returns of reference behaviours, ranked")
     s.add_argument("--skill", choices=list(SKILLS), default="grasp")

@@ -28,6 +28,8 @@ passed, then holding: :mod:`unicross.gaits`). Same seed and policy give identica
 """
 from __future__ import annotations
 
+import gzip
+import json
 import logging
 from pathlib import Path
 from typing import Callable, Dict, List, Optional, Sequence, Tuple
@@ -409,6 +411,15 @@ def _score(protocol, obj, axis, k, seed, axis_vec, x_oh, q_oh, p_w, q_w, drop, g
 
 
 # ----------------------------------------------------------------------------- summaries and tables
+def read_results(path) -> dict:
+    """A ``unicross eval`` result file, as written (``.json``) or as committed (``.json.gz``)."""
+    raw = Path(path).read_bytes()
+    r = json.loads(gzip.decompress(raw) if str(path).endswith(".gz") else raw)
+    if "summaries" not in r:
+        raise ValueError(f"{path} is not a `unicross eval` result")
+    return r
+
+
 def summarize(protocol: str, trials: List[dict]) -> dict:
     succ = torch.tensor([t["success"] for t in trials], dtype=torch.bool)
     kept = torch.tensor([not t["dropped"] for t in trials], dtype=torch.bool)
