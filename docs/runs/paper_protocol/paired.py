@@ -6,16 +6,10 @@ correlation of the pairs) and the exact McNemar p (two-sided binomial test on th
     python docs/runs/paper_protocol/paired.py A.json[.gz] B.json[.gz] [--skill translate]
 """
 import argparse
-import gzip
-import json
 import math
 
+from unicross.evaluation import read_results
 from unicross.metrics import wilson_interval as wilson
-
-
-def load(path):
-    with (gzip.open(path, "rt") if path.endswith(".gz") else open(path)) as f:
-        return json.load(f)
 
 
 def mcnemar_exact(b, c):
@@ -47,7 +41,7 @@ def main():
     p.add_argument("second")
     p.add_argument("--skill", default=None, help="the protocol's key in 'trials' (default: the only one)")
     args = p.parse_args()
-    runs = [load(args.first), load(args.second)]
+    runs = [read_results(args.first), read_results(args.second)]
     skill = args.skill or next(iter(runs[0]["trials"]))
     key = ("object", "axis", "trial", "seed")
     trials = [{tuple(t[k] for k in key): t["success"] for t in r["trials"][skill]} for r in runs]
