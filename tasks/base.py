@@ -60,6 +60,31 @@ def _freeze_heap_once() -> None:
         _HEAP_FROZEN = True
 
 
+def pair_walk(per_mode: Sequence[Sequence[int]], mode_ids: Sequence[int], order: str) -> list[tuple[int, int]]:
+    """The (object, mode) pairs in the order a task's envs take them: from a cursor that starts at a
+    seeded random place and moves on by the number of envs at every scene rebuild (``TaskScene``).
+    ``per_mode[k]``: the indices of the objects valid for mode ``mode_ids[k]``.
+
+    A CPU worker (one env) walks a few hundred consecutive pairs in a run, so the order decides what
+    it trains on. ``balanced`` (the default): round ``r`` holds one pair of every mode, the mode's
+    object at place ``r`` of a fixed shuffle of its objects (a shorter list is cycled), so every
+    window of consecutive pairs has each mode equally often and a spread of its objects over the
+    set's categories and shapes. ``sequential`` (before 2026-11-28): objects in the set's order,
+    modes round-robin until each mode's list ends; a window then holds one shape group (the sets list
+    boxes before cylinders), and after the in-hand modes' shorter lists end only grasp and relocate.
+    """
+    lists = [list(lst) for lst in per_mode]
+    if order == "sequential":
+        return [(lst[r], mi) for r in range(max(map(len, lists), default=0)) for lst, mi in zip(lists, mode_ids)
+                if r < len(lst)]
+    if order != "balanced":
+        raise ValueError(f"pair_order must be 'balanced' or 'sequential', not {order!r}")
+    rng = np.random.RandomState(0)  # fixed: the same walk in every process; the cursor's start is seeded
+    shuffled = [[lst[i] for i in rng.permutation(len(lst))] for lst in lists]
+    return [(lst[r % len(lst)], mi) for r in range(max(map(len, lists), default=0))
+            for lst, mi in zip(shuffled, mode_ids) if lst]
+
+
 def _map_tensors(obs, fn):
     if torch.is_tensor(obs):
         return fn(obs)
@@ -136,13 +161,10 @@ class UniCrossEnv(TaskScene, EpisodeStarts, StepMath, TaskStateIO, BaseEnv):
         self.object_names = [o.name for o in objs]
         objs = [o.scaled(self.hand_spec.object_scale) for o in objs]
         self.object_specs = objs
-        # valid (object, mode) pairs (the object's category is one of its skill's, see the registry),
-        # interleaved round-robin over modes so that consecutive pairs (parallel envs, successive
-        # rebuilds) spread over all modes
-        per_mode = [[(oi, F.MODES.index(m)) for oi, o in enumerate(objs) if o.category in R.skill_of_mode(m).categories]
-                    for m in modes]
-        self._pairs = [lst[r] for r in range(max(map(len, per_mode), default=0)) for lst in per_mode if r < len(lst)]
-        if not self._pairs:
+        # valid (object, mode) pairs: the object's category is one of its skill's (see the registry);
+        # the order envs walk them in is ``pair_walk`` (task.yaml: pair_order)
+        per_mode = [[oi for oi, o in enumerate(objs) if o.category in R.skill_of_mode(m).categories] for m in modes]
+        if not any(per_mode):
             raise ValueError(f"no object of the given set fits modes {list(modes)} "
                              f"(rotate needs wrappable objects, translate elongated ones)")
         self.modes_used = modes
@@ -159,7 +181,7 @@ class UniCrossEnv(TaskScene, EpisodeStarts, StepMath, TaskStateIO, BaseEnv):
             if self.grasps.hand != self.hand_spec.name:
                 raise ValueError(f"grasp dataset {path} is for hand {self.grasps.hand!r}, not {self.hand_spec.name!r}")
             have = {n for n, c in self.grasps.counts().items() if c > 0}
-            needed = {self.object_names[oi] for oi, mi in self._pairs if in_hand(F.MODES[mi])}
+            needed = {self.object_names[oi] for m, lst in zip(modes, per_mode) if in_hand(m) for oi in lst}
             missing = sorted(needed - have)
             if missing and len(missing) == len(needed):
                 raise ValueError(f"grasp dataset {path} has no grasps for the {len(missing)} object(s) of "
@@ -167,8 +189,9 @@ class UniCrossEnv(TaskScene, EpisodeStarts, StepMath, TaskStateIO, BaseEnv):
             if missing:  # a few objects the synthesiser could not grasp: they only serve the grasp mode
                 logger.warning(f"{len(missing)} object(s) have no grasp in {path} and are left out of the "
                                f"in-hand modes, e.g. {missing[:3]}")
-                self._pairs = [(oi, mi) for oi, mi in self._pairs
-                               if not in_hand(F.MODES[mi]) or self.object_names[oi] in have]
+                per_mode = [lst if not in_hand(m) else [oi for oi in lst if self.object_names[oi] in have]
+                            for m, lst in zip(modes, per_mode)]
+        self._pairs = pair_walk(per_mode, [F.MODES.index(m) for m in modes], self.cfg["pair_order"])
         register_hand_agent(self.hand_spec)
         super().__init__(*args, robot_uids=self.hand_spec.uid, **kwargs)
         n = self.hand_spec.dof

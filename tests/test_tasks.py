@@ -155,13 +155,36 @@ def test_invalid_arguments_fail_fast_with_valid_values():
 def test_multiskill_pairs_are_valid(tiny_objects, grasp_file):
     env = make("UniCross-MultiSkill-v1", grasp_file)
     u = env.unwrapped
-    assert len(u._pairs) == 2 * 8 + 2 * 4  # wrappable: grasp, relocate, 6 rotations; elongated: grasp, relocate, 2 translations
-    for oi, mi in u._pairs:
-        skill = F.mode_skill(F.MODES[mi])
-        cat = u.object_specs[oi].category
-        assert not (skill == "rotate" and cat != "wrappable") and not (skill == "translate" and cat != "elongated")
+    valid = set()
+    for oi, o in enumerate(u.object_specs):  # wrappable: grasp, relocate, 6 rotations; elongated: grasp, relocate, 2 translations
+        for mi, m in enumerate(F.MODES):
+            skill = F.mode_skill(m)
+            if not (skill == "rotate" and o.category != "wrappable") and not (skill == "translate" and o.category != "elongated"):
+                valid.add((oi, mi))
+    assert len(valid) == 2 * 8 + 2 * 4 and set(u._pairs) == valid
     assert u.mode.shape == (1,) and u.mode.dtype == torch.long
     env.close()
+
+
+def test_pair_walk_spreads_every_window_over_modes_and_objects():
+    from tasks.base import pair_walk
+    # a set listed as the real ones are: 6 boxes, then 6 cylinders; two modes valid for all of them, one for
+    # the last 4 only (a shorter list, as rotate's and translate's are)
+    per_mode = [list(range(12)), list(range(12)), list(range(8, 12))]
+    walk = pair_walk(per_mode, [0, 1, 5], "balanced")
+    assert set(walk) == {(o, m) for lst, m in zip(per_mode, [0, 1, 5]) for o in lst}
+    assert len(walk) == 3 * 12  # the shorter list cycles: every mode in every round
+    for start in range(len(walk) - 3):
+        assert sorted(m for _, m in walk[start:start + 3]) == [0, 1, 5]
+    for mi in (0, 1):  # the first half of a mode's pairs is no longer one shape group
+        first = [o for o, m in walk if m == mi][:6]
+        assert any(o < 6 for o in first) and any(o >= 6 for o in first)
+    assert pair_walk(per_mode, [0, 1, 5], "balanced") == walk  # the same walk in every process
+    # the order before: objects in the set's order, the shorter list ending early
+    seq = pair_walk(per_mode, [0, 1, 5], "sequential")
+    assert seq[:3] == [(0, 0), (0, 1), (8, 5)] and seq[-2:] == [(11, 0), (11, 1)] and len(seq) == 28
+    with pytest.raises(ValueError, match="balanced"):
+        pair_walk(per_mode, [0, 1, 5], "random")
 
 
 # ----------------------------------------------------------------------------- target semantics
