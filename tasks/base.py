@@ -66,12 +66,13 @@ def pair_walk(per_mode: Sequence[Sequence[int]], mode_ids: Sequence[int], order:
     ``per_mode[k]``: the indices of the objects valid for mode ``mode_ids[k]``.
 
     A CPU worker (one env) walks a few hundred consecutive pairs in a run, so the order decides what
-    it trains on. ``balanced`` (the default): round ``r`` holds one pair of every mode, the mode's
-    object at place ``r`` of a fixed shuffle of its objects (a shorter list is cycled), so every
-    window of consecutive pairs has each mode equally often and a spread of its objects over the
-    set's categories and shapes. ``sequential`` (before 2026-11-28): objects in the set's order,
-    modes round-robin until each mode's list ends; a window then holds one shape group (the sets list
-    boxes before cylinders), and after the in-hand modes' shorter lists end only grasp and relocate.
+    it trains on. ``sequential`` (the default, what every shipped checkpoint was trained with): objects
+    in the set's order, modes round-robin until each mode's list ends; a window then holds one shape
+    group (the sets list boxes before cylinders), and after the in-hand modes' shorter lists end only
+    grasp and relocate. ``balanced``: round ``r`` holds one pair of every mode, the mode's object at
+    place ``r`` of a fixed shuffle of its objects (a shorter list is cycled), so every window of
+    consecutive pairs has each mode equally often and a spread of its objects over the set's
+    categories and shapes (measured once, a DAgger fine-tuning stage: README "Pair walk").
     """
     lists = [list(lst) for lst in per_mode]
     if order == "sequential":
