@@ -172,6 +172,7 @@ class UniCrossEnv(TaskScene, EpisodeStarts, StepMath, TaskStateIO, BaseEnv):
         skills = {F.mode_skill(m) for m in modes}
         self.static_skill = skills.pop() if len(skills) == 1 else None  # lets target updates skip other rules
         self.grasps: Optional[GraspSet] = None
+        missing: list[str] = []  # objects of in-hand modes without a grasp: they only serve the grasp mode
         in_hand = lambda mode: not R.skill_of_mode(mode).starts_on_table  # noqa: E731  (starts from a grasp)
         if any(in_hand(m) for m in modes):
             if isinstance(grasp_dataset, GraspSet):
@@ -187,12 +188,13 @@ class UniCrossEnv(TaskScene, EpisodeStarts, StepMath, TaskStateIO, BaseEnv):
             if missing and len(missing) == len(needed):
                 raise ValueError(f"grasp dataset {path} has no grasps for the {len(missing)} object(s) of "
                                  f"this set, e.g. {missing[:3]}; build them with `unicross grasps --objects <set>`")
-            if missing:  # a few objects the synthesiser could not grasp: they only serve the grasp mode
+            if missing:
                 logger.warning(f"{len(missing)} object(s) have no grasp in {path} and are left out of the "
                                f"in-hand modes, e.g. {missing[:3]}")
-                per_mode = [lst if not in_hand(m) else [oi for oi in lst if self.object_names[oi] in have]
-                            for m, lst in zip(modes, per_mode)]
         self._pairs = pair_walk(per_mode, [F.MODES.index(m) for m in modes], self.cfg["pair_order"])
+        if missing:
+            self._pairs = [(oi, mi) for oi, mi in self._pairs
+                           if not in_hand(F.MODES[mi]) or self.object_names[oi] not in missing]
         register_hand_agent(self.hand_spec)
         super().__init__(*args, robot_uids=self.hand_spec.uid, **kwargs)
         n = self.hand_spec.dof

@@ -166,6 +166,20 @@ def test_multiskill_pairs_are_valid(tiny_objects, grasp_file):
     env.close()
 
 
+@pytest.mark.parametrize("order", ["sequential", "balanced"])
+def test_objects_without_grasps_serve_only_the_grasp_mode(tiny_objects, grasp_file, order):
+    from unicross.grasps import GraspSet
+    gs = GraspSet.load(grasp_file)
+    gone = gs.object_names.index(tiny_objects[0].name)  # the wrappable box
+    partial = GraspSet(gs.hand, gs.object_names, gs.data[gs.data["object_id"] != gone], gs.source)
+    env = make("UniCross-MultiSkill-v1", None, grasp_dataset=partial, config={"pair_order": order})
+    u = env.unwrapped
+    modes_of_box = {F.MODES[mi] for oi, mi in u._pairs if u.object_names[oi] == tiny_objects[0].name}
+    assert modes_of_box == {"grasp"}
+    assert sum(F.mode_skill(F.MODES[mi]) == "rotate" for _, mi in u._pairs) > 0  # the wrappable cylinder still rotates
+    env.close()
+
+
 def test_pair_walk_spreads_every_window_over_modes_and_objects():
     from tasks.base import pair_walk
     # a set listed as the real ones are: 6 boxes, then 6 cylinders; two modes valid for all of them, one for
