@@ -72,7 +72,7 @@ def pair_walk(per_mode: Sequence[Sequence[int]], mode_ids: Sequence[int], order:
     grasp and relocate. ``balanced``: round ``r`` holds one pair of every mode, the mode's object at
     place ``r`` of a fixed shuffle of its objects (a shorter list is cycled), so every window of
     consecutive pairs has each mode equally often and a spread of its objects over the set's
-    categories and shapes (measured once, a DAgger fine-tuning stage: README "Pair walk").
+    categories and shapes (measured in a DAgger fine-tuning stage, two seeds: README "Pair walk").
     """
     lists = [list(lst) for lst in per_mode]
     if order == "sequential":

@@ -42,19 +42,31 @@ def _close(key, a, b):
     return abs(a - b) <= TOLERANCE.get(key, 1e-3 * max(1.0, abs(b)))
 
 
+# Trials whose outcome may flip between CPUs: a trial on the edge of a drop can end either way after the
+# float differences of another CPU have grown over 70 steps (2026-11-28: the grasp expert on
+# wrappable-box-test-100 dropped it at step 71 on the VM that wrote the pin and held it on another,
+# every other trial equal). One such trial is tolerated; a change of behaviour moves more.
+FLIPS_ALLOWED = 1
+
+
 def test_pinned_evaluation_is_unchanged():
     if not os.path.exists(PIN):
         pytest.fail(f"{PIN} is missing; write it with: python tests/test_regression.py --write")
     pinned = json.load(open(PIN))
     now = _evaluate()
     assert sorted(now) == sorted(pinned)
+    flipped = []
     for case, trials in pinned.items():
         assert len(now[case]) == len(trials), case
         for got, want in zip(now[case], trials):
-            for k in EXACT:
-                assert got.get(k) == want.get(k), (case, want["object"], k, got.get(k), want.get(k))
+            assert all(got.get(k) == want.get(k) for k in ("object", "axis", "trial", "seed")), (case, want)
+            if any(got.get(k) != want.get(k) for k in EXACT):
+                flipped.append((case, want["object"], {k: (got.get(k), want.get(k)) for k in EXACT
+                                                       if got.get(k) != want.get(k)}))
+                continue
             for k, v in want.items():
                 assert _close(k, got.get(k), v), (case, want["object"], k, got.get(k), v)
+    assert len(flipped) <= FLIPS_ALLOWED, flipped
 
 
 if __name__ == "__main__":
