@@ -193,8 +193,9 @@ class UniCrossEnv(TaskScene, EpisodeStarts, StepMath, TaskStateIO, BaseEnv):
                                f"in-hand modes, e.g. {missing[:3]}")
         self._pairs = pair_walk(per_mode, [F.MODES.index(m) for m in modes], self.cfg["pair_order"])
         if missing:
+            gone = set(missing)
             self._pairs = [(oi, mi) for oi, mi in self._pairs
-                           if not in_hand(F.MODES[mi]) or self.object_names[oi] not in missing]
+                           if not in_hand(F.MODES[mi]) or self.object_names[oi] not in gone]
         register_hand_agent(self.hand_spec)
         super().__init__(*args, robot_uids=self.hand_spec.uid, **kwargs)
         n = self.hand_spec.dof
