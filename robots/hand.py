@@ -44,7 +44,7 @@ import yaml
 PROCEDURAL = "procedural://"
 WRIST_JOINTS = ["wrist_tx", "wrist_ty", "wrist_tz", "wrist_rx", "wrist_ry", "wrist_rz"]
 HAND_FRAME_LINK = "hand_frame"
-from unicross.config import CONFIG_DIR
+from unicross.config import CONFIG_DIR, atomic_write
 
 
 def cache_dir() -> Path:
@@ -327,10 +327,7 @@ def build_floating_urdf(spec: HandSpec) -> Path:
     digest = hashlib.sha1(text.encode()).hexdigest()[:12]
     out = cache_dir() / "robots" / f"{spec.name}_floating_{digest}.urdf"
     if not out.exists():
-        out.parent.mkdir(parents=True, exist_ok=True)
-        tmp = out.with_suffix(".tmp")
-        tmp.write_text('<?xml version="1.0"?>\n' + text)
-        os.replace(tmp, out)
+        atomic_write(out, lambda tmp: tmp.write_text('<?xml version="1.0"?>\n' + text))
     return out
 
 

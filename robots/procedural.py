@@ -22,12 +22,13 @@ from __future__ import annotations
 import dataclasses
 import hashlib
 import math
-import os
 from pathlib import Path
 from typing import Callable, Dict, List, Optional, Sequence, Tuple
 import xml.etree.ElementTree as ET
 
 import numpy as np
+
+from unicross.config import atomic_write
 
 Vec = Sequence[float]
 
@@ -310,8 +311,5 @@ def write_procedural_urdf(name: str, directory: Path) -> Path:
     digest = hashlib.sha1(text.encode()).hexdigest()[:12]
     out = Path(directory) / f"{name}_{digest}.urdf"
     if not out.exists():
-        out.parent.mkdir(parents=True, exist_ok=True)
-        tmp = out.with_suffix(".tmp")
-        tmp.write_text(text)
-        os.replace(tmp, out)
+        atomic_write(out, lambda tmp: tmp.write_text(text))
     return out

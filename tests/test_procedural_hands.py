@@ -89,3 +89,36 @@ def test_mano_matches_its_reference(reference):
     spec = load_hand("mano")
     floating = ET.parse(build_floating_urdf(spec)).getroot()
     assert sum(j.get("type") != "fixed" for j in floating.findall("joint")) == 26 == spec.dof
+
+
+def test_writers_of_one_cache_file_at_once_both_succeed(tmp_path, monkeypatch):
+    """Two env workers on a fresh machine generate the same procedural URDF at once: a second writer
+    that runs whole between the first one's write and its rename (here called from inside the
+    first one's write) must not take the first one's temporary file away (it did: one shared
+    ``.tmp`` name, and the first rename failed with FileNotFoundError)."""
+    import unicross.robots.procedural as P
+    from unicross.config import atomic_write
+
+    nested = []
+    real_write_text = Path.write_text
+
+    def write_text(self, text, *a, **kw):
+        n = real_write_text(self, text, *a, **kw)
+        if not nested:
+            nested.append(None)  # the second writer's own write does not nest again
+            nested[0] = P.write_procedural_urdf("mano", tmp_path)
+        return n
+
+    monkeypatch.setattr(Path, "write_text", write_text)
+    out = P.write_procedural_urdf("mano", tmp_path)
+    monkeypatch.undo()
+    assert nested == [out] and out.read_text() == urdf_text(GENERATORS["mano"]())
+    assert sorted(p.name for p in tmp_path.iterdir()) == [out.name]  # no temporary file left
+
+    def fail(tmp):
+        tmp.write_text("half")
+        raise RuntimeError("writer failed")
+
+    with pytest.raises(RuntimeError):
+        atomic_write(tmp_path / "x.urdf", fail)
+    assert sorted(p.name for p in tmp_path.iterdir()) == [out.name]  # neither the file nor its temporary

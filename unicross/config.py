@@ -167,3 +167,24 @@ class FrozenConfig(dict):
 def freeze(cfg: Mapping) -> FrozenConfig:
     """``cfg`` with every nested dict as a :class:`FrozenConfig`."""
     return FrozenConfig({k: freeze(v) if isinstance(v, Mapping) else v for k, v in cfg.items()})
+
+
+def atomic_write(path, write) -> Path:
+    """Create ``path`` whole or not at all, safely against other processes writing it at once:
+    ``write(tmp)`` fills a temporary file of a unique name in the same folder (it keeps ``path``'s
+    suffix, so writers that pick a format by extension still do), which then replaces ``path``.
+    Several processes that fill the same content-addressed cache file (env workers starting on a
+    fresh machine) each rename their own file, the last one winning."""
+    import os
+    import tempfile
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.stem}.", suffix=".tmp" + path.suffix)
+    os.close(fd)
+    try:
+        write(Path(tmp))
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    return path

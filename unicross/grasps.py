@@ -19,7 +19,6 @@ same format; tasks read it through :class:`GraspSet`.
 """
 from __future__ import annotations
 
-import os
 from collections import Counter
 from pathlib import Path
 from typing import Dict, List, Optional, Sequence
@@ -27,7 +26,7 @@ from typing import Dict, List, Optional, Sequence
 import torch
 from tensordict import TensorDict
 
-from unicross.config import CONFIG_DIR
+from unicross.config import CONFIG_DIR, atomic_write
 
 FORMAT = "unicross-grasps/1"
 KEYS = ("finger_qpos", "finger_target", "wrist_pose", "object_pose_hand", "object_id")
@@ -82,13 +81,9 @@ class GraspSet:
         return {self.object_names[i]: c.get(i, 0) for i in range(len(self.object_names))}
 
     def save(self, path) -> Path:
-        path = Path(path)
-        path.parent.mkdir(parents=True, exist_ok=True)
-        tmp = path.with_suffix(path.suffix + ".tmp")
-        torch.save({"format": FORMAT, "hand": self.hand, "source": self.source,
-                    "object_names": self.object_names, "data": self.data.to_dict()}, tmp)
-        os.replace(tmp, path)
-        return path
+        state = {"format": FORMAT, "hand": self.hand, "source": self.source,
+                 "object_names": self.object_names, "data": self.data.to_dict()}
+        return atomic_write(path, lambda tmp: torch.save(state, tmp))
 
     @classmethod
     def load(cls, path) -> "GraspSet":

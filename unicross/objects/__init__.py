@@ -25,6 +25,7 @@ from typing import List, Optional, Tuple
 
 import numpy as np
 
+from unicross.config import atomic_write
 from unicross.geometry import SHAPE_BOX, SHAPE_CYLINDER, SHAPE_MESH, SHAPE_PRISM, SHAPE_SPHERE
 
 CATEGORIES = ("wrappable", "elongated")
@@ -179,9 +180,7 @@ def prism_obj_file(radius: float, half_len: float, n: int) -> Path:
     if not out.exists():
         m = trimesh.Trimesh(*prism_mesh(radius, half_len, n), process=True)
         m.fix_normals()
-        tmp = out.with_suffix(".tmp.obj")
-        m.export(tmp)
-        tmp.replace(out)
+        atomic_write(out, lambda tmp: m.export(tmp))
     return out
 
 
