@@ -51,6 +51,18 @@ def test_relocate_audit_ranks_following_the_target_first():
     assert next(r for r in rows if r.behaviour == "stay").success == 0.0  # holding still never relocates
 
 
+def test_grasp_audit_of_mano_with_the_papers_termination_pays_grasping_over_holding_the_wrist_down():
+    """MANO's recipe (README "Other hands"): training's default (a drop does not end the episode) paid
+    holding the wrist down against the lift more than the scripted grasp on average (its failed lifts
+    are penalised to the end), and PPO learned it; with the paper's termination the grasp ranks first.
+    ``hold_down`` never lifts the object, so it never drops it."""
+    rows = audit("grasp", hand="mano", limit=1, seeds=1, progress=False, only=["scripted", "hold_down"],
+                 ppo_overrides={"env": {"task_config": {"terminate_on_drop": True}}})
+    assert [r.behaviour for r in rows] == ["scripted", "hold_down"]
+    hold = rows[1]
+    assert hold.success == 0.0 and hold.terms["drop"] == 0.0
+
+
 def test_paper_reward_pays_hovering_more_than_grasping():
     """The measurement that forced the success term: with the paper's coefficients, hovering
     above the object out-earns a successful grasp (as PPO sees it: discounted, scaled)."""

@@ -11,6 +11,8 @@ Grasp behaviours (scripted on the task's own state, through the normal action in
   scripted       descend, close, lift (the scripted grasp synthesiser's policy)
   descend_close  descend and close, then hold still (the task's lift phase raises the wrist)
   hover          descend, never close
+  hold_down      hover, then hold the wrist down against the task's lift (the wrist's residual cancels
+                 its rise): the object is never lifted, so it never counts as dropped
   close_only     close the fingers where the hand starts (above the object)
   zero           no action
   random         uniform random actions
@@ -44,6 +46,7 @@ import torch
 from unicross import formulation as F
 from unicross.seeding import trial_seed
 from unicross.config import load_config
+from unicross.geometry import quat_apply, quat_inv
 
 from unicross.rewards import term_names
 
@@ -65,6 +68,25 @@ def _grasp_script(lift: bool, close: bool, descend: bool):
             return a
         return act
     return make
+
+
+def _hold_down(u):
+    """Hover (descend, never close); from the lift phase on, the wrist's translation residual cancels
+    the task's lift (``lift_speed`` along the world's up for each step after ``lift_after``): a grasp
+    policy can learn this where every failed lift is penalised until the episode ends."""
+    hover = _grasp_script(lift=False, close=False, descend=True)(u)
+    g = u.cfg["grasp"]
+    step = 0
+
+    def act():
+        nonlocal step
+        a = hover()
+        if g["lift_after"] is not None and step >= g["lift_after"]:
+            up_root = quat_apply(quat_inv(u.root_q), torch.tensor([0.0, 0.0, 1.0], device=u.device).expand(u.num_envs, 3))
+            a[:, :3] = -(up_root * g["lift_speed"] * u.control_dt) / u.action_scale[:3]
+        step += 1
+        return a.clamp(-1.0, 1.0)
+    return act
 
 
 def _zero(u):
@@ -225,7 +247,7 @@ def behaviours(skill: str, seed: int = 0, axis: Optional[str] = None, hand: str 
     if skill == "grasp":
         return dict(scripted=_grasp_script(lift=True, close=True, descend=True),
                     descend_close=_grasp_script(lift=False, close=True, descend=True),
-                    hover=_grasp_script(lift=False, close=False, descend=True),
+                    hover=_grasp_script(lift=False, close=False, descend=True), hold_down=_hold_down,
                     close_only=_grasp_script(lift=False, close=True, descend=False), **common)
     if skill == "relocate":
         return dict(follow=_zero, follow_tight=_follow_relocate, naive=_naive_relocate, stay=_stay,
