@@ -208,3 +208,30 @@ def test_kl_stop_ends_the_epochs_early(tmp_path):
     steps = {name: json.loads((tmp_path / name / "metrics.jsonl").read_text().splitlines()[0])["minibatch_steps"]
              for name in ("full", "stop")}
     assert steps == {"full": 4, "stop": 1}
+
+
+def test_resumed_run_with_more_frames_replaces_its_final_evaluation(tmp_path):
+    """A finished run resumed with a larger ``collector.total_frames`` trains on and evaluates the
+    policy it ends with (the earlier ``final_eval.json`` had kept the first run's result); a resume
+    that trains nothing keeps the evaluation it has."""
+    import json
+    run = tmp_path / "run"
+    ev = dict(TINY["logging"], final_eval_trials=1, final_eval_limit=1)
+    t = PPOTrainer(run, "grasp", overrides=dict(TINY, collector=dict(total_frames=32, horizon=16), logging=ev),
+                   progress=False)
+    try:
+        assert t.train()["final"]["n"] > 0
+    finally:
+        t.close()
+    assert json.loads((run / "final_eval.json").read_text())["frames"] == 32
+    t = PPOTrainer(run, resume=True, overrides=dict(collector=dict(total_frames=48)), progress=False)
+    try:
+        assert "final" in t.train() and t.frames == 48
+    finally:
+        t.close()
+    assert json.loads((run / "final_eval.json").read_text())["frames"] == 48
+    t = PPOTrainer(run, resume=True, overrides=dict(collector=dict(total_frames=48)), progress=False)
+    try:
+        assert "final" not in t.train()
+    finally:
+        t.close()

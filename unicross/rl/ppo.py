@@ -324,10 +324,18 @@ class PPOTrainer(Runner):
         if evaluating and self.frames >= total:
             summary["end"] = self.evaluate()
             self._log_eval(summary["end"])
-        if eval_at_ends and lc["final_eval_trials"] > 0 and self.frames >= total \
-                and not (self.run_dir / "final_eval.json").exists():
+        if eval_at_ends and lc["final_eval_trials"] > 0 and self.frames >= total and not self._final_eval_current():
             summary["final"] = self.final_evaluation()
         return summary
+
+    def _final_eval_current(self) -> bool:
+        """Whether the run directory's ``final_eval.json`` evaluated the policy as it is now (a run
+        resumed with more ``--total-frames`` trains on, and its earlier final evaluation is replaced)."""
+        path = self.run_dir / "final_eval.json"
+        try:
+            return json.loads(path.read_text()).get("frames") == self.frames
+        except (OSError, ValueError):
+            return False
 
     def _iterate(self, total: int, max_iterations: Optional[int], bar, evaluating: bool) -> None:
         """Iterations (collect, update, log, periodic checkpoint and evaluation) until ``total``
