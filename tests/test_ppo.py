@@ -213,7 +213,7 @@ def test_kl_stop_ends_the_epochs_early(tmp_path):
 def test_resumed_run_with_more_frames_replaces_its_final_evaluation(tmp_path):
     """A finished run resumed with a larger ``collector.total_frames`` trains on and evaluates the
     policy it ends with (the earlier ``final_eval.json`` had kept the first run's result); a resume
-    that trains nothing keeps the evaluation it has."""
+    that trains nothing keeps the evaluation it has, and does the one that is missing."""
     import json
     run = tmp_path / "run"
     ev = dict(TINY["logging"], final_eval_trials=1, final_eval_limit=1)
@@ -235,3 +235,10 @@ def test_resumed_run_with_more_frames_replaces_its_final_evaluation(tmp_path):
         assert "final" not in t.train()
     finally:
         t.close()
+    (run / "final_eval.json").unlink()  # e.g. stopped during its final evaluation: a resume does it
+    t = PPOTrainer(run, resume=True, progress=False)
+    try:
+        assert "final" in t.train() and t.frames == 48
+    finally:
+        t.close()
+    assert json.loads((run / "final_eval.json").read_text())["frames"] == 48

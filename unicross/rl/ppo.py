@@ -310,7 +310,8 @@ class PPOTrainer(Runner):
         if evaluating and self.iteration == 0:
             summary["start"] = self.evaluate()
             self._log_eval(summary["start"])
-        if remaining == 0:
+        if remaining == 0:  # finished: only a missing or stale final evaluation is left to do
+            self._final_if_due(summary, eval_at_ends)
             return summary
         bar = tqdm(total=total, initial=self.frames, unit="frame", desc=f"ppo {self.skill}", disable=not self.progress)
         try:
@@ -324,9 +325,14 @@ class PPOTrainer(Runner):
         if evaluating and self.frames >= total:
             summary["end"] = self.evaluate()
             self._log_eval(summary["end"])
-        if eval_at_ends and lc["final_eval_trials"] > 0 and self.frames >= total and not self._final_eval_current():
-            summary["final"] = self.final_evaluation()
+        if self.frames >= total:
+            self._final_if_due(summary, eval_at_ends)
         return summary
+
+    def _final_if_due(self, summary: dict, eval_at_ends: bool) -> None:
+        """The held-out final evaluation of a finished run, unless ``final_eval.json`` already holds it."""
+        if eval_at_ends and self.cfg["logging"]["final_eval_trials"] > 0 and not self._final_eval_current():
+            summary["final"] = self.final_evaluation()
 
     def _final_eval_current(self) -> bool:
         """Whether the run directory's ``final_eval.json`` evaluated the policy as it is now (a run
