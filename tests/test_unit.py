@@ -247,6 +247,23 @@ def test_training_reads_another_grasp_dataset_only_for_in_hand_skills(tmp_path):
     assert env_kwargs_for("relocate", None, "allegro", env)["grasp_dataset"] == str(tmp_path / "none.pt")
 
 
+def test_training_ends_grasp_episodes_at_a_drop_and_in_hand_episodes_not():
+    """configs/ppo.yaml's env.terminate_on_drop is per skill (grasp: the paper's termination; the others
+    go on, penalised); a run's own task_config.terminate_on_drop wins, for every skill; a skill name
+    that does not exist is refused."""
+    from unicross.rl.ppo import env_kwargs_for
+    env = load_config("ppo")["env"]
+    ends = {sk: env_kwargs_for(sk, ax, "allegro", env)["config"]["terminate_on_drop"]
+            for sk, ax in (("grasp", None), ("relocate", None), ("rotate", "x+"), ("translate", "z-"))}
+    assert ends == dict(grasp=True, relocate=False, rotate=False, translate=False)
+    own = load_config("ppo", {"env": {"task_config": {"terminate_on_drop": False, "table": True}}})["env"]
+    assert env_kwargs_for("grasp", None, "allegro", own)["config"] == dict(terminate_on_drop=False, table=True)
+    assert env_kwargs_for("rotate", "x+", "allegro", load_config(
+        "ppo", {"env": {"terminate_on_drop": {"rotate": True}}})["env"])["config"]["terminate_on_drop"] is True
+    with pytest.raises(KeyError, match="env.terminate_on_drop.grsp"):
+        load_config("ppo", {"env": {"terminate_on_drop": {"grsp": True}}})
+
+
 @pytest.mark.parametrize("once", [True, False])
 def test_training_log_counts_an_episode_success_as_the_protocol_does(once):
     """PPO's logged success per finished episode: for a ``success_once`` skill (rotate, translate) the

@@ -57,8 +57,12 @@ def env_kwargs_for(skill: str, axis: Optional[str], hand: str, env_cfg: dict) ->
     """The env constructor arguments of one expert (validates skill and axis before any simulation)."""
     kw = dict(R.skill(skill).env_kwargs(axis), hand=hand, randomize=env_cfg["randomize"],
               reconfiguration_freq=env_cfg["reconfiguration_freq"] if env_cfg["backend"] == "physx_cpu" else 0)
-    if env_cfg.get("task_config"):
-        kw["config"] = env_cfg["task_config"]
+    task = dict(env_cfg.get("task_config") or {})
+    by_skill = env_cfg.get("terminate_on_drop") or {}
+    if by_skill.get(skill) is not None and "terminate_on_drop" not in task:  # a run's own task_config wins
+        task["terminate_on_drop"] = bool(by_skill[skill])
+    if task:
+        kw["config"] = task
     if env_cfg.get("reward_config"):
         kw["reward_config"] = env_cfg["reward_config"]
     if env_cfg.get("objects"):
