@@ -114,6 +114,10 @@ def test_writers_of_one_cache_file_at_once_both_succeed(tmp_path, monkeypatch):
     monkeypatch.undo()
     assert nested == [out] and out.read_text() == urdf_text(GENERATORS["mano"]())
     assert sorted(p.name for p in tmp_path.iterdir()) == [out.name]  # no temporary file left
+    plain = tmp_path.parent / f"{tmp_path.name}-plain.urdf"
+    plain.write_text("x")
+    assert out.stat().st_mode == plain.stat().st_mode  # the permissions of any file written here (not 0600)
+    plain.unlink()
 
     def fail(tmp):
         tmp.write_text("half")

@@ -171,20 +171,20 @@ def freeze(cfg: Mapping) -> FrozenConfig:
 
 def atomic_write(path, write) -> Path:
     """Create ``path`` whole or not at all, safely against other processes writing it at once:
-    ``write(tmp)`` fills a temporary file of a unique name in the same folder (it keeps ``path``'s
-    suffix, so writers that pick a format by extension still do), which then replaces ``path``.
-    Several processes that fill the same content-addressed cache file (env workers starting on a
-    fresh machine) each rename their own file, the last one winning."""
+    ``write(tmp)`` creates a temporary file of a unique name in the same folder (it keeps ``path``'s
+    suffix, so writers that pick a format by extension still do; the writer creates it, so it gets
+    the usual permissions), which then replaces ``path``. Several processes that fill the same
+    content-addressed cache file (env workers starting on a fresh machine) each rename their own
+    file, the last one winning; a failed writer leaves neither file."""
     import os
-    import tempfile
+    import uuid
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.stem}.", suffix=".tmp" + path.suffix)
-    os.close(fd)
+    tmp = path.with_name(f".{path.stem}.{os.getpid()}.{uuid.uuid4().hex[:8]}.tmp{path.suffix}")
     try:
-        write(Path(tmp))
+        write(tmp)
         os.replace(tmp, path)
     except BaseException:
-        Path(tmp).unlink(missing_ok=True)
+        tmp.unlink(missing_ok=True)
         raise
     return path
