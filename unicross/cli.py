@@ -384,8 +384,8 @@ def markdown_path(out: Path) -> Path:
 
 def _write_eval(out: Path, result: dict) -> str:
     """Writes an evaluation's JSON and markdown table atomically; returns the table."""
-    import os
     from unicross import evaluation as E
+    from unicross.config import atomic_write
     if out.is_dir():
         raise ValueError(f"--out {out} is a directory; give a file name such as {out / 'eval.json'}")
     try:
@@ -394,12 +394,10 @@ def _write_eval(out: Path, result: dict) -> str:
         raise ValueError(f"--out {out}: {out.parent} is not a directory") from None
     table = E.markdown_table({result["label"]: result["summaries"]}) if result["summaries"] else ""
     for path, text in ((out, json.dumps(result, indent=1)), (markdown_path(out), table + "\n")):
-        tmp = path.with_name(f"{path.name}.{os.getpid()}.tmp")
         try:
-            tmp.write_text(text)
+            atomic_write(path, lambda tmp: tmp.write_text(text))
         except OSError as e:
             raise ValueError(f"cannot write --out {out}: {e.strerror}") from None
-        os.replace(tmp, path)
     return table
 
 

@@ -87,6 +87,7 @@ def settle_vec_isa() -> bool:
     import hashlib
     import json
     import platform
+    from unicross.config import atomic_write
     try:
         from torch._inductor import config as ic
         from torch._inductor import cpu_vec_isa as isa
@@ -101,10 +102,8 @@ def settle_vec_isa() -> bool:
             passed = json.loads(record.read_text())["passed"]
         except (OSError, ValueError, KeyError, TypeError):
             passed = [str(v) for v in isa.valid_vec_isa_list()]  # the probes, in this process
-            root.mkdir(parents=True, exist_ok=True)
-            tmp = record.with_suffix(f".{os.getpid()}.tmp")
-            tmp.write_text(json.dumps(dict(torch=torch.__version__, claimed=claimed, passed=passed)))
-            os.replace(tmp, record)
+            text = json.dumps(dict(torch=torch.__version__, claimed=claimed, passed=passed))
+            atomic_write(record, lambda tmp: tmp.write_text(text))
     except Exception:  # an optimisation over torch internals: never a reason to fail a compile
         return False
     if passed != claimed:

@@ -28,7 +28,7 @@ from typing import Optional
 import numpy as np
 import torch
 
-from unicross.config import deep_merge, load_config, validate_ranges
+from unicross.config import atomic_write, deep_merge, load_config, validate_ranges
 from unicross.rl.collector import register_run, update_threads
 
 CKPT_NAME = "checkpoint.pt"
@@ -54,11 +54,11 @@ def fsync_dir(path: Path) -> None:
 def atomic_save(obj, path: Path) -> None:
     """``torch.save`` to a temporary file of this process, fsync, rename over ``path``, fsync the
     directory: a reader sees the old file or the new one, never a torn one."""
-    tmp = path.with_name(f"{path.name}.{os.getpid()}.tmp")
-    torch.save(obj, tmp)
-    with open(tmp, "rb") as f:
-        os.fsync(f.fileno())
-    os.replace(tmp, path)
+    def write(tmp: Path) -> None:
+        torch.save(obj, tmp)
+        with open(tmp, "rb") as f:
+            os.fsync(f.fileno())
+    atomic_write(path, write)
     fsync_dir(path.parent)
 
 
@@ -103,9 +103,7 @@ def truncate_logs(run_dir: Path, key: str, last: int) -> int:
             keep = lines[:1] + [l for l in lines[1:] if int(float(next(csv.reader([l]))[col])) <= last]
         if len(keep) < len(lines):
             dropped += len(lines) - len(keep)
-            tmp = path.with_name(f"{path.name}.{os.getpid()}.tmp")
-            tmp.write_text("".join(keep))
-            os.replace(tmp, path)
+            atomic_write(path, lambda tmp: tmp.write_text("".join(keep)))
     return dropped
 
 
