@@ -58,9 +58,9 @@ def env_kwargs_for(skill: str, axis: Optional[str], hand: str, env_cfg: dict) ->
     kw = dict(R.skill(skill).env_kwargs(axis), hand=hand, randomize=env_cfg["randomize"],
               reconfiguration_freq=env_cfg["reconfiguration_freq"] if env_cfg["backend"] == "physx_cpu" else 0)
     task = dict(env_cfg.get("task_config") or {})
-    by_skill = env_cfg.get("terminate_on_drop") or {}
-    if by_skill.get(skill) is not None and "terminate_on_drop" not in task:  # a run's own task_config wins
-        task["terminate_on_drop"] = bool(by_skill[skill])
+    ends = (env_cfg.get("terminate_on_drop") or {}).get(skill)
+    if ends is not None and "terminate_on_drop" not in task:  # a run's own task_config wins
+        task["terminate_on_drop"] = bool(ends)
     if task:
         kw["config"] = task
     if env_cfg.get("reward_config"):
