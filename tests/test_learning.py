@@ -275,7 +275,7 @@ def test_shipped_relocate_expert_relocates_a_held_out_object(hand):
     policy, desc = E.resolve_policy(f"{hand}/relocate", hand)
     assert desc["skill"] == "relocate"
     # the second test box: Sharpa Wave's expert turns the first one in its grasp in 2 of 3 trials (0.14-0.27
-    # rad off the goal; 97.5% of the report's cell), which the zero action does not
+    # rad off the goal; 97.5% over the held-out cell), which the zero action does not
     obj = [o for o in get_object_set("test-wrappable") if o.name == "wrappable-box-test-101"]
     trials = E.run_protocol("relocate", policy, obj, hand=hand, trials_per_object=2, seed=0, progress=False)
     assert sum(t["success"] for t in trials) >= 1
