@@ -100,6 +100,19 @@ def test_paper_values_format():
     assert _paper("Experts", "grasp") == "99.0"
 
 
+def test_paper_column_of_another_hand_is_its_row_of_the_hands_table():
+    """For MANO and Sharpa Wave the experts' and the student's tables show the paper's row of that hand
+    (its hands table), and the settings the paper reports for Allegro only show "--"; a hand the paper
+    does not have gets "--" everywhere."""
+    from unicross.report import _paper
+    assert _paper("Ours", "relocate", "mano") == "96.6 / 1.26 / 0.0207"
+    assert _paper("Experts", "grasp", "sharpa_wave") == "99.1"
+    assert _paper("Ours", "translate", "sharpa_wave") == "99.0 / 17.8"
+    assert _paper("Uns.", "grasp", "mano") == "--" and _paper("Dis.", "relocate", "sharpa_wave") == "--"
+    assert _paper("Ours", "grasp", "inspire") == "--"
+    assert _paper("Uns.", "grasp", "allegro") == "95.8"
+
+
 def test_a_checkpoint_on_top_of_a_gait_is_named_so_in_the_tables(tmp_path):
     import torch
     from unicross.report import policy_label
