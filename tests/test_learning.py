@@ -284,22 +284,23 @@ def test_shipped_relocate_expert_relocates_a_held_out_object(hand):
         E.resolve_policy(f"{hand}/relocate", other)
 
 
-def _shipped_and_zero(spec: str, skill: str, axis: str, objects, trials_per_object: int):
+def _shipped_and_zero(spec: str, skill: str, axis: str, objects, trials_per_object: int, hand: str = "allegro"):
     """(trials of the shipped checkpoint ``spec``, trials of the zero action) under the paper's
-    protocol of ``skill`` about/along ``axis`` on ``objects``; checks the checkpoint's mode first."""
+    protocol of ``skill`` about/along ``axis`` on ``objects`` with ``hand``; checks the checkpoint's mode first."""
     from unicross import evaluation as E
-    policy, desc = E.resolve_policy(spec, "allegro")
+    policy, desc = E.resolve_policy(spec, hand)
     assert (desc["skill"], desc.get("axis")) == (skill, axis)
-    kw = dict(trials_per_object=trials_per_object, seed=0, progress=False, axes=[axis])
+    kw = dict(trials_per_object=trials_per_object, seed=0, progress=False, axes=[axis], hand=hand)
     return E.run_protocol(skill, policy, objects, **kw), E.run_protocol(skill, E.zero_policy, objects, **kw)
 
 
-def test_shipped_translate_expert_translates_a_held_out_object():
-    """The shipped translate z+ expert (allegro/translate_z+) slides a held elongated test object
+@pytest.mark.parametrize("hand", ["allegro", "sharpa_wave"])
+def test_shipped_translate_expert_translates_a_held_out_object(hand):
+    """The shipped translate z+ expert (<hand>/translate_z+) slides a held elongated test object
     out along the fingers under the paper's translate protocol, farther than the zero action."""
     from unicross.objects import get_object_set
-    trials, zero = _shipped_and_zero("allegro/translate_z+", "translate", "z+",
-                                     get_object_set("test-elongated", limit=1)[:1], trials_per_object=2)
+    trials, zero = _shipped_and_zero(f"{hand}/translate_z+", "translate", "z+",
+                                     get_object_set("test-elongated", limit=1)[:1], trials_per_object=2, hand=hand)
     assert sum(t["success"] for t in trials) >= 1 and not any(t["success"] for t in zero)
 
 
@@ -314,19 +315,24 @@ def test_shipped_rotate_policy_turns_a_held_out_object():
     assert sum(t["success"] for t in trials) >= 1 and not any(t["success"] for t in zero)
 
 
-def test_shipped_student_is_distilled_for_every_mode_and_grasps_a_held_out_object():
-    """The shipped student (allegro/student) was distilled from the ten shipped checkpoints, and
-    the one network grasps and lifts a held-out test object under the paper's grasp protocol, where
-    the zero action lifts none (first two test objects, one trial each)."""
+@pytest.mark.parametrize("hand", ["allegro", "sharpa_wave"])
+def test_shipped_student_is_distilled_for_every_shipped_expert_and_grasps_a_held_out_object(hand):
+    """The shipped student (<hand>/student) was distilled from every shipped expert of its hand (Allegro:
+    the ten modes; Sharpa Wave: grasp, relocate, translate z+), and the one network grasps and lifts a
+    held-out test object under the paper's grasp protocol, where the zero action lifts none (first two
+    test objects, one trial each)."""
     from unicross import formulation as F
     from unicross import evaluation as E
     from unicross.objects import get_object_set
+    from unicross.report import shipped
     from unicross.rl.policy_io import read_torch_file, resolve_checkpoint
-    ck = read_torch_file(resolve_checkpoint("allegro/student"), "checkpoint")
-    assert ck["skill"] == "multi" and sorted(ck["distilled_modes"]) == sorted(F.MODES)
-    policy, _ = E.resolve_policy("allegro/student", "allegro")
+    ck = read_torch_file(resolve_checkpoint(f"{hand}/student"), "checkpoint")
+    experts = sorted(m for m in shipped(hand) if m in F.MODES)
+    assert ck["skill"] == "multi" and sorted(ck["distilled_modes"]) == experts
+    assert hand != "allegro" or experts == sorted(F.MODES)
+    policy, _ = E.resolve_policy(f"{hand}/student", hand)
     objs = get_object_set("test", limit=1)[:2]
-    kw = dict(trials_per_object=1, seed=0, progress=False)
+    kw = dict(trials_per_object=1, seed=0, progress=False, hand=hand)
     trials, zero = E.run_protocol("grasp", policy, objs, **kw), E.run_protocol("grasp", E.zero_policy, objs, **kw)
     assert sum(t["success"] for t in trials) >= 1 and not any(t["success"] for t in zero)
 
