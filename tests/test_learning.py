@@ -315,10 +315,10 @@ def test_shipped_rotate_policy_turns_a_held_out_object():
     assert sum(t["success"] for t in trials) >= 1 and not any(t["success"] for t in zero)
 
 
-@pytest.mark.parametrize("hand", ["allegro", "sharpa_wave"])
+@pytest.mark.parametrize("hand", ["allegro", "mano", "sharpa_wave"])
 def test_shipped_student_is_distilled_for_every_shipped_expert_and_grasps_a_held_out_object(hand):
     """The shipped student (<hand>/student) was distilled from every shipped expert of its hand (Allegro:
-    the ten modes; Sharpa Wave: grasp, relocate, translate z+), and the one network grasps and lifts a
+    the ten modes; MANO: grasp, relocate; Sharpa Wave: grasp, relocate, translate z+), and the one network grasps and lifts a
     held-out test object under the paper's grasp protocol, where the zero action lifts none (first two
     test objects, one trial each)."""
     from unicross import formulation as F
