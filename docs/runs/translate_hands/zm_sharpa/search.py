@@ -11,7 +11,9 @@ Each candidate runs ``unicross eval --policy seq:SPEC`` on the first 4 training 
         index:4,middle:4,ring:4,pinky:5,thumb:5 \
         0.017,0.019,0.015,-0.009,0.023,0.012,0.022,-0.007,-0.016,-0.017 OUTDIR --sigma 0.008
 
-(the sitting of 2026-11-28 ran it from /work/scratch with OUTDIR there; its log is ``search.jsonl``).
+(2026-11-28: Sharpa Wave's search ran an earlier copy of this file with the same sampling, scoring and update and
+the output folder fixed in the code, its log is ``search.jsonl``; MANO's (``../zm_mano/``) and Allegro's
+(``docs/runs/translate_zm_reference/constant_rate_search/``) ran this file).
 """
 import argparse
 import hashlib
