@@ -8,7 +8,8 @@ to a grasped object, in the task itself (grasp-state starts, random wrist orient
     finger f's joints (abduction, MCP, PIP = DIP) follow q0 + bias + amplitude * sin(2 pi t / T + phase),
     with the distal joints shifted by a loop phase (a closed path in joint space), T in 6..36 steps
 
-25 numbers in [-1, 1] per gait (6 per finger and the period), the wrist holding still. Each gait
+6 numbers in [-1, 1] per finger and the period (25 for Allegro; ``--hand`` another hand, its fingers' joints
+as :func:`unicross.gaits.gait_layout` reads them), the wrist holding still. Each gait
 runs on the first ``--limit`` objects per group of ``--objects`` x ``--seeds`` starts (the
 audit's seeds) for ``--steps`` control steps or until the object drops; per episode it records
 the object's accumulated rotation (the integral of its angular velocity in the hand frame: what
@@ -81,26 +82,34 @@ import time
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-from unicross.gaits import NPAR, gait_targets  # noqa: E402
+from unicross.gaits import gait_targets, layout_of  # noqa: E402
 _ENVS = {}
 
 
+def _objects(name: str, limit: int, hand: str, grasps=None) -> list:
+    """The first ``limit`` objects per group of set ``name`` that have a grasp state for ``hand`` (in-hand
+    starts need one; every Allegro training object has)."""
+    from unicross.grasps import GraspSet, default_grasp_path
+    from unicross.objects import get_object_set
+    have = {n for n, c in GraspSet.load(grasps or default_grasp_path(hand)).counts().items() if c > 0}
+    return [o for o in get_object_set(name, limit=limit) if o.name in have]
+
+
 def _env(job):
-    key = (job["skill"], job["axis"], job["objects"], job["limit"], job["oi"], job["randomize"], job["grasps"])
+    key = (job["hand"], job["skill"], job["axis"], job["objects"], job["limit"], job["oi"], job["randomize"], job["grasps"])
     if key not in _ENVS:
         import gymnasium as gym
         import unicross  # noqa: F401  (registers the tasks)
         from unicross.config import load_config
-        from unicross.objects import get_object_set
         from unicross.registry import skill as skill_entry
         from unicross.rl.ppo import env_kwargs_for
-        kw = env_kwargs_for(job["skill"], job["axis"], "allegro", load_config("ppo", None)["env"])
+        kw = env_kwargs_for(job["skill"], job["axis"], job["hand"], load_config("ppo", None)["env"])
         kw.pop("object_limit", None)
         kw.pop("reconfiguration_freq", None)
         kw["randomize"] = job["randomize"]
         if job["grasps"] is not None:
             kw["grasp_dataset"] = job["grasps"]
-        obj = get_object_set(job["objects"], limit=job["limit"])[job["oi"]]
+        obj = _objects(job["objects"], job["limit"], job["hand"], job["grasps"])[job["oi"]]
         _ENVS[key] = gym.make(skill_entry(job["skill"]).env_id, obs_mode="state", sim_backend="physx_cpu",
                               render_backend="none", num_envs=1, **{**kw, "objects": [obj]})
     return _ENVS[key].unwrapped
@@ -116,10 +125,11 @@ def episode(job) -> list:
     torch.set_num_threads(1)
     u = _env(job)
     u.reset(seed=job["seed"])
+    layout = layout_of(job["hand"])
     p = torch.as_tensor(job["p"], dtype=torch.float32)
-    p[:24] *= job["amplitude"]
+    p[:-1] *= job["amplitude"]
     if job["finger"] is not None:  # one finger moves, the others keep only their bias (tightening or loosening)
-        for f in range(4):
+        for f in range(len(layout.fingers)):
             if f != job["finger"]:
                 p[6 * f: 6 * f + 3] = 0.0
     q0 = u.command[0, 6:].clone()
@@ -129,7 +139,7 @@ def episode(job) -> list:
     for t in range(job["steps"]):
         a = torch.zeros(1, u.action_scale.shape[0])
         if not exceeded:
-            a[0, 6:] = ((gait_targets(p, t + 1, q0) - u.command[0, 6:]) / u.action_scale[6:]).clamp(-1, 1)
+            a[0, 6:] = ((gait_targets(p, t + 1, q0, layout) - u.command[0, 6:]) / u.action_scale[6:]).clamp(-1, 1)
         _, _, term, trunc, _ = u.step(a)
         steps += 1
         if bool(term[0]) or bool(u.ever_dropped[0]):
@@ -151,9 +161,10 @@ def evaluate(pool, gaits, args, n_obj, first: int = 0, hold=None, seeds=None, pa
     from unicross.seeding import trial_seed
     seeds = list(range(args.seeds)) if seeds is None else list(seeds)
     pairs = [(oi, k) for oi in range(n_obj) for k in seeds] if pairs is None else list(pairs)
-    jobs = [dict(p=p.tolist(), oi=oi, seed=trial_seed(0, oi, k), skill=args.skill, axis=args.axis,
+    n_fingers = len(layout_of(args.hand).fingers)
+    jobs = [dict(p=p.tolist(), oi=oi, seed=trial_seed(0, oi, k), hand=args.hand, skill=args.skill, axis=args.axis,
                  objects=args.objects, limit=args.limit, randomize=not args.no_randomize, steps=args.steps,
-                 amplitude=args.amplitude, finger=(first + i) % 4 if args.one_finger else None, hold=hold,
+                 amplitude=args.amplitude, finger=(first + i) % n_fingers if args.one_finger else None, hold=hold,
                  grasps=args.grasps)
             for i, p in enumerate(gaits) for oi, k in pairs]
     return np.array(pool.map(episode, jobs, chunksize=1)).reshape(len(gaits), len(pairs), 9)
@@ -167,7 +178,7 @@ def sampled_pairs(rng, n_obj: int, sample: int, generation: int) -> list:
     return [(int(oi), 1000 + generation) for oi in sorted(objs)]
 
 
-def init_gaits(paths, amplitude: float, reverse: bool = False):
+def init_gaits(paths, amplitude: float, reverse: bool = False, hand: str = "allegro"):
     """(gaits [n, 25] as this search's parameters, their logged results [n, episodes, 8]) of the rows of
     earlier logs: a one-finger row gets its still fingers' amplitudes zeroed, and every row is rescaled
     from its log's ``--amplitude`` to ``amplitude`` (clipped to [-1, 1]), so it moves the fingers as logged.
@@ -176,17 +187,19 @@ def init_gaits(paths, amplitude: float, reverse: bool = False):
     generation tests it). The reversal acts on this search's parameters, which ``--amplitude`` scales
     phases included, so with an amplitude below 1 the gait runs backwards up to a time shift common
     to all fingers (the same motion from another start)."""
-    from unicross.gaits import read_log, reverse_gait
+    from unicross.gaits import gait_hand, read_log, reverse_gait
     ps, rs = [], []
     for path in paths:
         for row in read_log(path):
+            if gait_hand(row) != hand:
+                raise ValueError(f"{path}: a log of gaits for hand {gait_hand(row)!r}, this search is for {hand!r}")
             p = np.array(row["p"], dtype=float)
             finger = row.get("finger")
             if finger is not None:
-                for f in range(4):
+                for f in range(len(p) // 6):
                     if f != finger:
                         p[6 * f: 6 * f + 3] = 0.0
-            p[:24] = (p[:24] * row.get("meta", {}).get("amplitude", 1.0) / amplitude).clip(-1, 1)
+            p[:-1] = (p[:-1] * row.get("meta", {}).get("amplitude", 1.0) / amplitude).clip(-1, 1)
             r = np.array(row["r"])[:, :8]
             if reverse:
                 p = reverse_gait(p).double().numpy()
@@ -219,6 +232,7 @@ def summary(paths):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--hand", default="allegro", help="the hand (its fingers: unicross.gaits.gait_layout)")
     ap.add_argument("--skill", default="rotate", choices=["rotate", "translate"])
     ap.add_argument("--axis", default=None, help="the env's axis (rotation is measured about all three)")
     ap.add_argument("--objects", default=None, help="default: the skill's training set")
@@ -262,15 +276,15 @@ def main():
     args.axis = args.axis or ("z-" if args.skill == "translate" else "x+")
     args.objects = args.objects or ("train-elongated" if args.skill == "translate" else "train-wrappable")
     from multiprocessing import get_context
-    from unicross.objects import get_object_set
-    n_obj = len(get_object_set(args.objects, limit=args.limit))
+    n_obj = len(_objects(args.objects, args.limit, args.hand, args.grasps))
+    npar = layout_of(args.hand).npar
     rng = np.random.default_rng(args.seed)
     meta = {k: v for k, v in vars(args).items() if k not in ("summary", "out")}
     os.makedirs(os.path.dirname(os.path.abspath(args.out)), exist_ok=True)
     with get_context("spawn").Pool(2) as pool, open(args.out, "a") as log:
         if args.refine is None:
             for i in range(0, args.candidates, 8):
-                gaits = rng.uniform(-1, 1, size=(8, NPAR))
+                gaits = rng.uniform(-1, 1, size=(8, npar))
                 t0 = time.time()
                 res = evaluate(pool, gaits, args, n_obj, first=i)
                 for j, (p, r) in enumerate(zip(gaits, res)):
@@ -296,21 +310,21 @@ def main():
             partial = 0.5 * (sign * res[:, :, col] / unit).clip(-1, 1)
             return np.where(dropped, -0.5, np.where(ok, 1.0, partial)).mean(1)
 
-        mu, sig, pop = np.zeros(NPAR), np.full(NPAR, args.sigma), 16
+        mu, sig, pop = np.zeros(npar), np.full(npar, args.sigma), 16
         first = None
         if args.init and hold:  # the first generation: the logged gaits that moved the object furthest,
-            ps, rs = init_gaits(args.init, args.amplitude, args.init_reversed)  # drops ignored (holding might have prevented them)
+            ps, rs = init_gaits(args.init, args.amplitude, args.init_reversed, args.hand)  # drops ignored (holding might have prevented them)
             reach = (sign * rs[:, :, col] / unit).clip(-1, 1).mean(1)
             first = ps[np.argsort(-reach)[:pop]]
             print(f"first generation: the {pop} gaits of {len(ps)} in {args.init} that moved the object furthest "
                   f"(mean reach {np.sort(reach)[-pop:].mean():.2f} success units)", flush=True)
         elif args.init:
-            ps, rs = init_gaits(args.init, args.amplitude, args.init_reversed)
+            ps, rs = init_gaits(args.init, args.amplitude, args.init_reversed, args.hand)
             s0 = scores(rs)
             mu = ps[int(np.argmax(s0))]
             print(f"starting from the best gait of {args.init} (score {s0.max():.3f})", flush=True)
         for g in range(args.generations):
-            gaits = np.clip(mu + sig * rng.standard_normal((pop, NPAR)), -1, 1)
+            gaits = np.clip(mu + sig * rng.standard_normal((pop, npar)), -1, 1)
             gaits[0] = mu
             if g == 0 and first is not None:
                 gaits = first
@@ -320,7 +334,7 @@ def main():
             elite = np.argsort(-score)[:pop // 4]
             mu, sig = gaits[elite].mean(0), np.maximum(gaits[elite].std(0), 0.05)
             if g == 0 and first is not None:  # unrelated gaits: their mean is none of them; go on from the best
-                mu, sig = gaits[elite[0]], np.full(NPAR, args.sigma)
+                mu, sig = gaits[elite[0]], np.full(npar, args.sigma)
             for p, r, s in zip(gaits, res, score):
                 log.write(json.dumps(dict(meta=meta, generation=g, p=p.tolist(), r=r.tolist(), score=float(s),
                                           **({"pairs": pairs} if pairs else {}))) + "\n")

@@ -80,6 +80,9 @@ class HandSpec:
     # scripted grasp synthesiser: joint -> closing increment (rad); None = flex every joint but
     # the first of each finger by 0.7 rad (Allegro-like four-joint fingers)
     closing_delta: Optional[Dict[str, float]] = None
+    # scripted finger gaits (unicross.gaits): finger -> [abduction, proximal flexion, distal flexion...] joints;
+    # a finger not named moves its joints in order (a four-joint finger as Allegro's)
+    gait_joints: Optional[Dict[str, List[str]]] = None
     description: str = ""
 
     def __post_init__(self):
@@ -102,6 +105,11 @@ class HandSpec:
             if f in self.finger_joints or set(m) - {"joint", "multiplier", "offset"} or "joint" not in m:
                 raise ValueError(f"hand {self.name!r}: bad mimic entry {f!r}: {m} (a follower is not a "
                                  f"finger joint; keys: joint, multiplier, offset)")
+        for finger, js in (self.gait_joints or {}).items():
+            if finger not in self.fingers or len(js) < 3 or not set(js) <= set(self.fingers[finger]) \
+                    or len(set(js)) != len(js):
+                raise ValueError(f"hand {self.name!r}: gait_joints[{finger!r}] = {js} must name at least three "
+                                 f"distinct joints of that finger (abduction, proximal, distal...)")
         self.resolved_mimic()
         self.mount_rotation()
 

@@ -77,8 +77,8 @@ def test_the_policy_runs_the_gait_until_the_object_has_turned_past_the_angle_the
 def test_gait_policies_refuse_other_hands(tmp_path):
     from unicross.evaluation import resolve_policy
     _write(tmp_path / "log.jsonl", [dict(meta=dict(skill="rotate", refine="z+"), p=[0.0] * NPAR, score=0.0)])
-    with pytest.raises(ValueError, match="Allegro"):
-        resolve_policy(f"gait:{tmp_path / 'log.jsonl'}", "shadow")
+    with pytest.raises(ValueError, match="a gait for hand 'allegro', not 'sharpa_wave'"):
+        resolve_policy(f"gait:{tmp_path / 'log.jsonl'}", "sharpa_wave")
     policy, desc = resolve_policy(f"gait:{tmp_path / 'log.jsonl'}", "allegro")
     assert desc["kind"] == "gait" and desc["mode"] == "rotate_z+"
 
@@ -208,3 +208,44 @@ def test_the_guard_pauses_the_gait_and_tightens_while_too_few_links_touch(tmp_pa
     torch.testing.assert_close(u.command[0, 6:], gait_offsets(p, torch.tensor(4.0)) + 0.05 * closing, atol=1e-5, rtol=0)
     with pytest.raises(ValueError, match="guard"):
         make_gait_policy(str(tmp_path / "log.jsonl"), guard=-1)
+
+
+def test_a_gait_layout_follows_the_hand_and_keeps_allegros_gaits():
+    """Allegro's layout read from its description is the built-in one (its shipped gaits move the same joints);
+    Sharpa Wave's five fingers give 31 numbers that move only its named gait joints, flexing along the
+    closing direction with a positive bias; a gait of another hand's length is refused."""
+    from robots.hand import load_hand
+    from unicross.gaits import ALLEGRO_LAYOUT, gait_layout, gait_offsets, layout_of
+    assert gait_layout(load_hand("allegro")) == ALLEGRO_LAYOUT and ALLEGRO_LAYOUT.npar == NPAR
+    spec = load_hand("sharpa_wave")
+    layout = layout_of("sharpa_wave")
+    assert layout.npar == 31 and layout.n_joints == len(spec.finger_joints) == 22
+    p = torch.zeros(31)
+    p[5::6] = 1.0  # every finger's bias, no motion
+    off = gait_offsets(p, torch.tensor(3.0), layout=layout)
+    moved = {spec.finger_joints[i] for i in torch.nonzero(off).flatten().tolist()}
+    named = {j for js in spec.gait_joints.values() for j in js[1:]}  # flexion joints take the bias
+    assert moved == named
+    closing = torch.from_numpy(spec.closing_deltas())
+    assert torch.all(off[closing > 0] > 0)
+    with pytest.raises(ValueError, match="not one for hand 'sharpa_wave'"):
+        gait_offsets(torch.zeros(NPAR), torch.tensor(1.0), layout=layout)
+    with pytest.raises(ValueError, match="gait_joints"):
+        type(spec)(**{**spec.__dict__, "gait_joints": {"index": ["index_PIP", "thumb_IP", "x"]}})
+
+
+def test_a_gait_runs_only_on_the_hand_it_was_searched_for(tmp_path):
+    from unicross.evaluation import resolve_policy
+    _write(tmp_path / "log.jsonl", [dict(meta=dict(skill="rotate", refine="y-", hand="sharpa_wave"), p=[0.0] * 31,
+                                         score=0.0)])
+    policy, desc = resolve_policy(f"gait:{tmp_path / 'log.jsonl'}", "sharpa_wave")
+    assert desc["mode"] == "rotate_y-"
+    with pytest.raises(ValueError, match="a gait for hand 'sharpa_wave', not 'allegro'"):
+        resolve_policy(f"gait:{tmp_path / 'log.jsonl'}", "allegro")
+    u = _stand_in_env(1, "rotate_y-", [0.0, -1.0, 0.0])  # an Allegro stand-in
+    with pytest.raises(ValueError, match="cannot run hand 'allegro'"):
+        policy(None, u)
+    _write(tmp_path / "short.jsonl", [dict(meta=dict(skill="rotate", refine="y-", hand="sharpa_wave"), p=[0.0] * NPAR,
+                                           score=0.0)])
+    with pytest.raises(ValueError, match="not one for hand 'sharpa_wave'"):
+        make_gait_policy(str(tmp_path / "short.jsonl"))

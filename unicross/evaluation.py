@@ -204,12 +204,11 @@ def resolve_policy(spec: str, hand: str, seed: int = 0):
     if spec.startswith("experts:"):
         return make_experts_policy(spec[len("experts:"):], hand, seed)
     if spec.startswith("gait:"):
-        from unicross.gaits import make_gait_policy
+        from unicross.gaits import gait_hand, gait_mode, make_gait_policy
         path = spec[len("gait:"):]
-        if hand != "allegro":
-            raise ValueError(f"policy {spec!r}: gaits are written for Allegro's four fingers, not hand {hand!r}")
-        policy = make_gait_policy(path)  # a missing file fails here, before any simulation
-        from unicross.gaits import gait_mode
+        policy = make_gait_policy(path)  # a missing file or a gait of the wrong length fails here, before any simulation
+        if gait_hand(policy.gait_row) != hand:
+            raise ValueError(f"policy {spec!r} is a gait for hand {gait_hand(policy.gait_row)!r}, not {hand!r}")
         return policy, dict(kind="gait", path=path, mode=gait_mode(policy.gait_row), gait=policy.gait_row["p"],
                             meta=policy.gait_row.get("meta", {}))
     from unicross.rl.policy_io import base_policy_of, load_policy, policy_fn

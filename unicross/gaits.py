@@ -1,9 +1,12 @@
 """Open-loop periodic finger gaits, and the scripted in-hand policy that runs one until its mode is done.
 
-A gait is 25 numbers in [-1, 1] (6 per finger and the period); finger f's joints (abduction, MCP,
-PIP = DIP) follow ``q0 + bias + amplitude * sin(2 pi t / T + phase)`` around the start command q0,
-with the distal joints shifted by a loop phase (a closed path in joint space), T in 6..36 control
-steps; the wrist holds still. ``benchmarks/gait_search.py`` samples gaits and refines them with a
+A gait is 6 numbers in [-1, 1] per finger and the period (25 for Allegro's four fingers); finger f's
+joints (abduction, proximal flexion, distal flexion joints moving together) follow
+``q0 + bias + amplitude * sin(2 pi t / T + phase)`` around the start command q0, with the distal joints
+shifted by a loop phase (a closed path in joint space), T in 6..36 control steps; the wrist holds still.
+Which joints of a finger play which part is the hand's :func:`gait_layout` (a four-joint finger:
+abduction, proximal, then the two distal joints, as Allegro's; other fingers name theirs in the hand's
+``gait_joints``), and flexion follows the hand's closing direction, so a positive bias tightens. ``benchmarks/gait_search.py`` samples gaits and refines them with a
 cross-entropy search; its logs (JSON lines with ``p``, ``meta`` and, for a search, ``score``) are
 what :func:`best_gait` reads.
 
@@ -11,13 +14,15 @@ what :func:`best_gait` reads.
 (translate) the env's own axis exceeds the mode's success threshold, then holds the fingers where
 they are (the protocol counts a success only if the object is never dropped afterwards). The stop
 reads the task's privileged state (the object's velocity in the hand frame), as the scripted grasp
-does: a scripted reference, not a learned policy. Four fingers of four joints each (Allegro).
+does: a scripted reference, not a learned policy. A gait is searched for one hand (its log's ``meta.hand``,
+Allegro where a log names none) and runs on that hand only.
 """
 from __future__ import annotations
 
 import gzip
 import json
 import math
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Tuple
 
@@ -26,30 +31,75 @@ import torch
 from unicross import formulation as F
 from unicross.observations import contact as observed_contact
 
-NPAR = 6 * 4 + 1
+NPAR = 6 * 4 + 1  # the length of an Allegro gait (four fingers); other hands: gait_layout(spec).npar
 ROTATE_MODES = torch.tensor([F.mode_skill(m) == "rotate" for m in F.MODES])  # [modes]: rotation (else translation)
 
 
+@dataclass(frozen=True)
+class GaitLayout:
+    """The finger joints a gait moves, per finger of the hand (indices into its finger joints): the
+    abduction joint, the proximal flexion joint and the distal flexion joints, with the sign that
+    flexes each along the hand's closing direction."""
+    hand: str
+    n_joints: int
+    fingers: Tuple[Tuple[int, int, Tuple[int, ...], float, Tuple[float, ...]], ...]  # (abd, prox, distal, sign_prox, signs_distal)
+
+    @property
+    def npar(self) -> int:
+        """Parameters of a gait for this hand: 6 per finger and the period."""
+        return 6 * len(self.fingers) + 1
+
+
+def gait_layout(hand_spec) -> GaitLayout:
+    """The :class:`GaitLayout` of a hand: per finger its ``gait_joints`` (abduction, proximal, distal...)
+    where the hand names them, else its joints in order (a four-joint finger as Allegro's: abduction,
+    proximal, two distal); flexion signs from the hand's closing direction (+1 where it has none)."""
+    index = {j: i for i, j in enumerate(hand_spec.finger_joints)}
+    closing = hand_spec.closing_deltas()
+    named = getattr(hand_spec, "gait_joints", None) or {}
+    fingers = []
+    for finger, joints in hand_spec.fingers.items():
+        js = named.get(finger, joints)
+        if len(js) < 3:
+            raise ValueError(f"hand {hand_spec.name!r}: a gait needs an abduction, a proximal and a distal joint "
+                             f"per finger; finger {finger!r} gives {list(js)} (name them in the hand's gait_joints)")
+        ids = [index[j] for j in js]
+        sign = [-1.0 if closing[i] < 0 else 1.0 for i in ids]
+        fingers.append((ids[0], ids[1], tuple(ids[2:]), sign[1], tuple(sign[2:])))
+    return GaitLayout(hand_spec.name, len(hand_spec.finger_joints), tuple(fingers))
+
+
+# Allegro's layout without reading its description: its fingers are four joints each, flexing positive
+ALLEGRO_LAYOUT = GaitLayout("allegro", 16, tuple((4 * f, 4 * f + 1, (4 * f + 2, 4 * f + 3), 1.0, (1.0, 1.0))
+                                                 for f in range(4)))
+
+
+def _check_length(p, layout: GaitLayout) -> None:
+    if len(p) != layout.npar:
+        raise ValueError(f"a gait of {len(p)} numbers is not one for hand {layout.hand!r} ({len(layout.fingers)} "
+                         f"fingers: {layout.npar} numbers)")
+
+
 def gait_period(p) -> float:
-    """The period of gait ``p`` in control steps (6..36)."""
-    return 6 + 30 * (float(p[24]) + 1) / 2
+    """The period of gait ``p`` in control steps (6..36): its last number."""
+    return 6 + 30 * (float(p[-1]) + 1) / 2
 
 
-def gait_offsets(p, t, dtype=torch.float32) -> torch.Tensor:
-    """The finger targets of gait ``p`` ([25] in [-1, 1]) minus q0, [..., 16], at the (fractional)
-    control steps ``t`` [...], computed in ``dtype`` and returned in float32."""
+def gait_offsets(p, t, dtype=torch.float32, layout: GaitLayout = ALLEGRO_LAYOUT) -> torch.Tensor:
+    """The finger targets of gait ``p`` ([layout.npar] in [-1, 1]) minus q0, [..., layout.n_joints], at the
+    (fractional) control steps ``t`` [...], computed in ``dtype`` and returned in float32."""
+    _check_length(p, layout)
     period = gait_period(p)
     t = torch.as_tensor(t, dtype=dtype)
-    off = torch.zeros(t.shape + (16,), dtype=dtype, device=t.device)
-    for f in range(4):
+    off = torch.zeros(t.shape + (layout.n_joints,), dtype=dtype, device=t.device)
+    for f, (j_abd, j_prox, j_dis, s_prox, s_dis) in enumerate(layout.fingers):
         a_abd, a_mcp, a_dis, ph, loop, bias = (float(v) for v in p[6 * f: 6 * f + 6])
         th = 2 * math.pi * t / period + math.pi * ph
-        j = 4 * f
-        off[..., j] = 0.3 * a_abd * torch.sin(th)
-        off[..., j + 1] = 0.5 * a_mcp * torch.sin(th) + 0.2 * bias
+        off[..., j_abd] = 0.3 * a_abd * torch.sin(th)
+        off[..., j_prox] = s_prox * (0.5 * a_mcp * torch.sin(th) + 0.2 * bias)
         d = 0.5 * a_dis * torch.sin(th + math.pi * loop) + 0.2 * bias
-        off[..., j + 2] = d
-        off[..., j + 3] = d
+        for j, s in zip(j_dis, s_dis):
+            off[..., j] = s * d
     return off.float()
 
 
@@ -60,15 +110,29 @@ def reverse_gait(p) -> torch.Tensor:
     kinematic (slow, friction holding), so a gait for one direction of an axis is a candidate
     for the opposite direction."""
     q = torch.as_tensor(p, dtype=torch.float64).clone()
-    q[3:24:6] = (1.0 - q[3:24:6] + 1.0) % 2.0 - 1.0  # each finger's phase
-    q[4:24:6] = (-q[4:24:6] + 1.0) % 2.0 - 1.0  # each finger's loop phase
+    q[3:-1:6] = (1.0 - q[3:-1:6] + 1.0) % 2.0 - 1.0  # each finger's phase
+    q[4:-1:6] = (-q[4:-1:6] + 1.0) % 2.0 - 1.0  # each finger's loop phase
     return q.to(p.dtype if torch.is_tensor(p) else torch.float32)
 
 
-def gait_targets(p, t: int, q0: torch.Tensor) -> torch.Tensor:
-    """Finger targets [..., 16] of gait ``p`` at control step ``t`` around ``q0`` [..., 16] (the
+def gait_targets(p, t: int, q0: torch.Tensor, layout: GaitLayout = ALLEGRO_LAYOUT) -> torch.Tensor:
+    """Finger targets [..., n_joints] of gait ``p`` at control step ``t`` around ``q0`` [..., n_joints] (the
     offsets in float64, as the searches that found the shipped gaits computed them)."""
-    return q0 + gait_offsets(p, float(t), torch.float64).to(q0.device)
+    return q0 + gait_offsets(p, float(t), torch.float64, layout).to(q0.device)
+
+
+def gait_hand(row: dict) -> str:
+    """The hand a gait was searched for: a shipped gait's ``hand``, else its log's ``meta.hand``
+    (Allegro for the logs written before searches named one)."""
+    return row.get("hand") or row.get("meta", {}).get("hand") or "allegro"
+
+
+def layout_of(hand: str) -> GaitLayout:
+    """The :class:`GaitLayout` of a hand by name."""
+    if hand == "allegro":
+        return ALLEGRO_LAYOUT
+    from robots.hand import load_hand
+    return gait_layout(load_hand(hand))
 
 
 SHIPPED_DIR = Path(__file__).resolve().parent / "checkpoints"
@@ -126,7 +190,7 @@ def read_log(path: str) -> list:
 
 
 def best_gait(path: str) -> Tuple[torch.Tensor, dict]:
-    """(gait [25] with the log's amplitude applied to its amplitudes and bias, the row) of the best
+    """(gait [npar] with the log's amplitude applied to its amplitudes and bias, the row) of the best
     row of a gait log: the highest ``success`` of its selection rows (``--select``), else the
     highest search ``score``."""
     rows = read_log(path)
@@ -136,7 +200,7 @@ def best_gait(path: str) -> Tuple[torch.Tensor, dict]:
         raise ValueError(f"{path}: not a gait search log (no row with a 'score' or 'success')")
     row = max(rows, key=lambda r: r[key])
     p = torch.tensor(row["p"], dtype=torch.float32)
-    p[:24] *= float(row.get("meta", {}).get("amplitude", 1.0))
+    p[:-1] *= float(row.get("meta", {}).get("amplitude", 1.0))
     return p, row
 
 
@@ -202,15 +266,17 @@ def make_gait_policy(spec: str, tracking: str = "clock", lookahead: float = 1.0,
         mode = gait_mode(row)
         row = dict(row, mode=mode[:-1] + {"+": "-", "-": "+"}[mode[-1]], reversed_from=mode, p=p.tolist(),
                    meta=dict(row.get("meta", {}), amplitude=1.0))  # p has the log's amplitude applied already
+    hand = gait_hand(row)
+    layout = layout_of(hand)
+    _check_length(p, layout)
     period = gait_period(p)
     taus = torch.arange(int(math.ceil(period * grid))) / grid
-    cycle = gait_offsets(p, taus[taus < period])  # [K, 16] offsets over one period
+    cycle = gait_offsets(p, taus[taus < period], layout=layout)  # [K, n_joints] offsets over one period
     state = {}
 
     def policy(obs, u):
-        if u.hand_spec.dof - 6 != 16:
-            raise ValueError(f"gait policy: written for four fingers of four joints (Allegro), "
-                             f"hand {u.hand_spec.name!r} has {u.hand_spec.dof - 6} finger joints")
+        if u.hand_spec.name != hand:
+            raise ValueError(f"gait policy: a gait for hand {hand!r} cannot run hand {u.hand_spec.name!r}")
         t = int(u.elapsed_steps[0])
         if t == 0 or state.get("env") is not u:
             is_rot = ROTATE_MODES.to(u.device)[u.mode.long()]
@@ -238,14 +304,14 @@ def make_gait_policy(spec: str, tracking: str = "clock", lookahead: float = 1.0,
         if tracking == "clock":
             if guard > 0:  # the gait's own clock, which stands still while the guard tightens
                 state["clock"] += (~slipping).float()
-                target = centre + gait_offsets(p, state["clock"].double()).to(u.device)
+                target = centre + gait_offsets(p, state["clock"].double(), layout=layout).to(u.device)
             else:
-                target = gait_targets(p, t + 1, state["q0"])
+                target = gait_targets(p, t + 1, state["q0"], layout)
         else:
-            rel = u.command[:, 6:] - centre  # [N, 16]
+            rel = u.command[:, 6:] - centre  # [N, n_joints]
             k = ((cycle.to(u.device)[None] - rel[:, None]) ** 2).sum(-1).argmin(1)  # [N]
             ahead = torch.where(slipping, 0.0, lookahead) if guard > 0 else lookahead
-            target = centre + gait_offsets(p, taus.to(u.device)[k] + ahead)
+            target = centre + gait_offsets(p, taus.to(u.device)[k] + ahead, layout=layout)
         step = ((target - u.command[:, 6:]) / u.action_scale[6:]).clamp(-1, 1)
         a[:, 6:] = torch.where(state["done"][:, None], torch.zeros_like(step), step)
         return a
