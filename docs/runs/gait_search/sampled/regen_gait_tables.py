@@ -42,7 +42,9 @@ def main():
         mode = row.match(a).group(1)
         print(("replaced  " if mode in replaced else "unchanged ") + f"file: {a}\n{'':10}now:  {b}")
         if mode not in replaced and a != b:
-            moved.append(f"{mode} {a.split(' | ')[2].split(' [')[0]} -> {b.split(' | ')[2].split(' [')[0]}")
+            cell = [r.split(" | ")[2] for r in (a, b)]  # "SR [CI] (n), Rot. X rad"
+            moved.append(f"{mode} {cell[0].split(' [')[0]}, Rot. {cell[0].split('Rot. ')[-1]} -> "
+                         f"{cell[1].split(' [')[0]}, Rot. {cell[1].split('Rot. ')[-1]}")
     commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True).stdout.strip()
     note = (f"_These gait tables were regenerated on {datetime.date.today()} at {commit} (2 CPU cores) after the "
             f"{', '.join(sorted(replaced))} gait(s) were replaced, by `python docs/runs/gait_search/sampled/"
