@@ -214,7 +214,7 @@ def test_a_gait_layout_follows_the_hand_and_keeps_allegros_gaits():
     """Allegro's layout read from its description is the built-in one (its shipped gaits move the same joints);
     Sharpa Wave's five fingers give 31 numbers that move only its named gait joints, flexing along the
     closing direction with a positive bias; a gait of another hand's length is refused."""
-    from robots.hand import load_hand
+    from unicross.robots.hand import load_hand
     from unicross.gaits import ALLEGRO_LAYOUT, gait_layout, gait_offsets, layout_of
     assert gait_layout(load_hand("allegro")) == ALLEGRO_LAYOUT and ALLEGRO_LAYOUT.npar == NPAR
     spec = load_hand("sharpa_wave")
@@ -249,3 +249,17 @@ def test_a_gait_runs_only_on_the_hand_it_was_searched_for(tmp_path):
                                            score=0.0)])
     with pytest.raises(ValueError, match="not one for hand 'sharpa_wave'"):
         make_gait_policy(str(tmp_path / "short.jsonl"))
+
+
+def test_every_shipped_gait_loads_for_its_own_hand_only():
+    from unicross.evaluation import resolve_policy
+    from unicross.gaits import SHIPPED_DIR, shipped_gaits
+    hands = sorted(p.name for p in SHIPPED_DIR.iterdir() if (p / "gaits").is_dir())
+    assert "allegro" in hands and "sharpa_wave" in hands
+    for hand in hands:
+        for mode, spec in shipped_gaits(hand).items():
+            policy, desc = resolve_policy(f"gait:{spec}", hand)
+            assert desc["mode"] == mode and policy.gait_row["hand"] == hand
+            other = "allegro" if hand != "allegro" else "sharpa_wave"
+            with pytest.raises(ValueError, match=f"a gait for hand '{hand}', not '{other}'"):
+                resolve_policy(f"gait:{spec}", other)

@@ -131,7 +131,7 @@ def layout_of(hand: str) -> GaitLayout:
     """The :class:`GaitLayout` of a hand by name."""
     if hand == "allegro":
         return ALLEGRO_LAYOUT
-    from robots.hand import load_hand
+    from unicross.robots.hand import load_hand
     return gait_layout(load_hand(hand))
 
 

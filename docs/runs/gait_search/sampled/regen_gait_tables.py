@@ -8,6 +8,10 @@ on one machine, not across CPUs (the physics' floating point differs, and over 4
 2026-11-28, y+ 42.0 in the full run against 39.0 here), so those rows are reported, not required to match.
 
     python docs/runs/gait_search/sampled/regen_gait_tables.py docs/results.md rotate_x+ [rotate_z- ...]
+
+The report's parameters (hand, objects per group, trials, seed) are read from the command at the file's top; a hand
+whose report has no gait tables yet gets them where the report puts them (MODES: the gaits shipped, e.g.
+`docs/results_sharpa_wave.md rotate_y+`).
 """
 import datetime
 import re
@@ -22,38 +26,57 @@ def main():
     path, replaced = Path(sys.argv[1]), set(sys.argv[2:])
     text = path.read_text()
     command = re.search(r"^Command: `(.*)`$", text, re.M).group(1)
-    want = {"--hand": "allegro", "--limit": "10", "--trials-per-object": "3", "--min-trials": "100", "--seed": "0"}
     args = command.split()
-    for k, v in want.items():
-        if k not in args or args[args.index(k) + 1] != v:
-            sys.exit(f"{path}: its command {command!r} does not have {k} {v}, the parameters this script uses")
-    report = PaperReport(hand="allegro", limit=10, trials=3, workers=2, seed=0, min_trials=100)
+
+    def arg(key, default):
+        return args[args.index(key) + 1] if key in args else default
+    report = PaperReport(hand=arg("--hand", "allegro"), limit=int(arg("--limit", 10)) or None,
+                         trials=int(arg("--trials-per-object", 3)), workers=2, seed=int(arg("--seed", 0)),
+                         min_trials=int(arg("--min-trials", 100)))
     new = report._gait_tables()
     lines = text.split("\n")
-    start = lines.index("## Scripted finger gaits (not PPO experts), held-out test objects")
-    end = next(i for i in range(start + 1, len(lines)) if lines[i].startswith("## ") and "Scripted finger gaits" not in lines[i])
-    old = lines[start:end]
+    first = "## Scripted finger gaits (not PPO experts), held-out test objects"
+    if first in lines:  # the file's gait sections are replaced
+        start = lines.index(first)
+        end = next(i for i in range(start + 1, len(lines))
+                   if lines[i].startswith("## ") and "Scripted finger gaits" not in lines[i])
+    else:  # the hand's first gaits: where the report puts them, before the physical references or the baselines
+        start = end = next(i for i, ln in enumerate(lines)
+                           if ln.startswith(("## Physical references", "## Baselines")))
     row = re.compile(r"^\| (rotate_[xyz][+-]) \| gait:")
-    old_rows = [ln for ln in old if row.match(ln)]
-    new_rows = [ln for ln in new if row.match(ln)]
-    assert len(old_rows) == len(new_rows), (old_rows, new_rows)
+
+    def rows(block):  # (section index, mode) -> row
+        out, section = {}, -1
+        for ln in block:
+            section += ln.startswith("## ")
+            if row.match(ln):
+                out[(section, row.match(ln).group(1))] = ln
+        return out
+    old_rows, new_rows = rows(lines[start:end]), rows(new)
     moved = []
-    for a, b in zip(old_rows, new_rows):
-        mode = row.match(a).group(1)
-        print(("replaced  " if mode in replaced else "unchanged ") + f"file: {a}\n{'':10}now:  {b}")
-        if mode not in replaced and a != b:
+    for key, b in new_rows.items():
+        a = old_rows.get(key)
+        mode = key[1]
+        print(("replaced  " if mode in replaced else "unchanged " if a else "new       ") + f"file: {a}\n{'':10}now:  {b}")
+        if mode not in replaced and a is not None and a != b:
             cell = [r.split(" | ")[2] for r in (a, b)]  # "SR [CI] (n), Rot. X rad"
             moved.append(f"{mode} {cell[0].split(' [')[0]}, Rot. {cell[0].split('Rot. ')[-1]} -> "
                          f"{cell[1].split(' [')[0]}, Rot. {cell[1].split('Rot. ')[-1]}")
     commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True).stdout.strip()
+    kept = [key for key in new_rows if key in old_rows and key[1] not in replaced]
     note = (f"_These gait tables were regenerated on {datetime.date.today()} at {commit} (2 CPU cores) after the "
-            f"{', '.join(sorted(replaced))} gait(s) were replaced, by `python docs/runs/gait_search/sampled/"
+            f"{', '.join(sorted(replaced))} gait(s) were shipped, by `python docs/runs/gait_search/sampled/"
             f"regen_gait_tables.py {path} {' '.join(sorted(replaced))}` (the report's own code for these tables); the "
-            f"other sections are from the full run of the command above. The gaits not replaced gave "
-            + (f"other numbers here than in that run ({'; '.join(moved)}): outcomes differ between CPUs._"
-               if moved else "their rows of that run unchanged._"))
+            f"other sections are from the full run of the command above."
+            + ("" if not kept else " The gaits not replaced gave " + (
+                f"other numbers here than in that run ({'; '.join(moved)}): outcomes differ between CPUs."
+                if moved else "their rows of that run unchanged.")) + "_")
     new = new[:2] + [note, ""] + new[2:]
-    path.write_text("\n".join(lines[:start] + new + lines[end:]))
+    out = lines[:start] + new + lines[end:]
+    for mode in replaced:  # the expert tables point to the gait of a mode that has no expert, as the report does
+        out = [ln.replace(f"| {mode} | expert not shipped |", f"| {mode} | expert not shipped (a scripted gait: see below) |")
+               for ln in out]
+    path.write_text("\n".join(out))
     print(f"wrote {path}")
 
 
