@@ -179,7 +179,7 @@ def sampled_pairs(rng, n_obj: int, sample: int, generation: int) -> list:
 
 
 def init_gaits(paths, amplitude: float, reverse: bool = False, hand: str = "allegro"):
-    """(gaits [n, 25] as this search's parameters, their logged results [n, episodes, 8]) of the rows of
+    """(gaits [n, npar] as this search's parameters, their logged results [n, episodes, 8]) of the rows of
     earlier logs: a one-finger row gets its still fingers' amplitudes zeroed, and every row is rescaled
     from its log's ``--amplitude`` to ``amplitude`` (clipped to [-1, 1]), so it moves the fingers as logged.
     ``reverse``: each gait run backwards in time (:func:`unicross.gaits.reverse_gait`) and its logged
