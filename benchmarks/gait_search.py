@@ -72,6 +72,7 @@ Episodes run in two spawned worker processes, one env per object each.
 from __future__ import annotations
 
 import argparse
+import functools
 import gzip
 import json
 import math
@@ -86,13 +87,14 @@ from unicross.gaits import gait_targets, layout_of  # noqa: E402
 _ENVS = {}
 
 
-def _objects(name: str, limit: int, hand: str, grasps=None) -> list:
-    """The first ``limit`` objects per group of set ``name`` that have a grasp state for ``hand`` (in-hand
-    starts need one; every Allegro training object has)."""
-    from unicross.grasps import GraspSet, default_grasp_path
+@functools.lru_cache(maxsize=None)
+def _objects(skill: str, name: str, limit: int, hand: str, grasps=None) -> list:
+    """The first ``limit`` objects per group of set ``name`` that ``skill``'s protocol runs for ``hand``
+    (:func:`unicross.evaluation.protocol_objects`: its categories, with a grasp state; every Allegro training
+    object has one), read once per process."""
+    from unicross.evaluation import protocol_objects
     from unicross.objects import get_object_set
-    have = {n for n, c in GraspSet.load(grasps or default_grasp_path(hand)).counts().items() if c > 0}
-    return [o for o in get_object_set(name, limit=limit) if o.name in have]
+    return protocol_objects(skill, get_object_set(name, limit=limit), hand, grasps)[0]
 
 
 def _env(job):
@@ -109,7 +111,7 @@ def _env(job):
         kw["randomize"] = job["randomize"]
         if job["grasps"] is not None:
             kw["grasp_dataset"] = job["grasps"]
-        obj = _objects(job["objects"], job["limit"], job["hand"], job["grasps"])[job["oi"]]
+        obj = _objects(job["skill"], job["objects"], job["limit"], job["hand"], job["grasps"])[job["oi"]]
         _ENVS[key] = gym.make(skill_entry(job["skill"]).env_id, obs_mode="state", sim_backend="physx_cpu",
                               render_backend="none", num_envs=1, **{**kw, "objects": [obj]})
     return _ENVS[key].unwrapped
@@ -276,7 +278,7 @@ def main():
     args.axis = args.axis or ("z-" if args.skill == "translate" else "x+")
     args.objects = args.objects or ("train-elongated" if args.skill == "translate" else "train-wrappable")
     from multiprocessing import get_context
-    n_obj = len(_objects(args.objects, args.limit, args.hand, args.grasps))
+    n_obj = len(_objects(args.skill, args.objects, args.limit, args.hand, args.grasps))
     npar = layout_of(args.hand).npar
     rng = np.random.default_rng(args.seed)
     meta = {k: v for k, v in vars(args).items() if k not in ("summary", "out")}

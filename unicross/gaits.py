@@ -19,6 +19,7 @@ Allegro where a log names none) and runs on that hand only.
 """
 from __future__ import annotations
 
+import functools
 import gzip
 import json
 import math
@@ -56,7 +57,7 @@ def gait_layout(hand_spec) -> GaitLayout:
     proximal, two distal); flexion signs from the hand's closing direction (+1 where it has none)."""
     index = {j: i for i, j in enumerate(hand_spec.finger_joints)}
     closing = hand_spec.closing_deltas()
-    named = getattr(hand_spec, "gait_joints", None) or {}
+    named = hand_spec.gait_joints or {}
     fingers = []
     for finger, joints in hand_spec.fingers.items():
         js = named.get(finger, joints)
@@ -127,8 +128,9 @@ def gait_hand(row: dict) -> str:
     return row.get("hand") or row.get("meta", {}).get("hand") or "allegro"
 
 
+@functools.lru_cache(maxsize=None)
 def layout_of(hand: str) -> GaitLayout:
-    """The :class:`GaitLayout` of a hand by name."""
+    """The :class:`GaitLayout` of a hand by name (its description read once per process)."""
     if hand == "allegro":
         return ALLEGRO_LAYOUT
     from unicross.robots.hand import load_hand
