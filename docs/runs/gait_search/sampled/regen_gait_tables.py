@@ -69,8 +69,8 @@ def main():
             f"regen_gait_tables.py {path} {' '.join(sorted(replaced))}` (the report's own code for these tables); the "
             f"other sections are from the full run of the command above."
             + ("" if not kept else " The gaits not replaced gave " + (
-                f"other numbers here than in that run ({'; '.join(moved)}): outcomes differ between CPUs."
-                if moved else "their rows of that run unchanged.")) + "_")
+                f"other numbers here than the rows this file had ({'; '.join(moved)}): outcomes differ between CPUs."
+                if moved else "the rows this file had, to the trial.")) + "_")
     new = new[:2] + [note, ""] + new[2:]
     out = lines[:start] + new + lines[end:]
     for mode in replaced:  # the expert tables point to the gait of a mode that has no expert, as the report does
