@@ -47,7 +47,7 @@ from unicross import formulation as F
 
 def _rollouts(gait: str, hand: str, objects: str, limit: int, trials: int, seed: int, randomize: bool,
               student, shard, beta: float = 0.0, privileged_q0: bool = False, clock: bool = False,
-              history: bool = False, sequence: str = None, mode: str = None, grasps: str = None) -> tuple:
+              history: int = 0, sequence: str = None, mode: str = None, grasps: str = None) -> tuple:
     """One worker's share: (obs dict of [N, d], labels [N, A], trials) of the protocol of the gait's mode
     on its objects, the gait acting (``student`` None) or the student's mean acting while the gait labels
     (with ``sequence``, a finger sequence of :mod:`unicross.sequences` on ``mode``'s protocol instead);
@@ -79,10 +79,12 @@ def _rollouts(gait: str, hand: str, objects: str, limit: int, trials: int, seed:
     def policy(obs, u):
         label = teacher(obs, u)
         parts = split_obs(obs)
-        if history:  # diagnosis only: the previous control step's s^h appended (the step's own at t = 0)
+        if history:  # diagnosis only: the last `history` control steps' s^h appended (the first step's own before it)
             now = parts[0]
-            before = now if int(u.elapsed_steps[0]) == 0 else prev["h"]
-            prev["h"] = now.clone()
+            if int(u.elapsed_steps[0]) == 0:
+                prev["h"] = now.repeat(1, history)
+            before = prev["h"]
+            prev["h"] = torch.cat([now, before[:, :-now.shape[-1]]], -1)
             parts = (torch.cat([now, before], -1),) + tuple(parts[1:])
         if privileged_q0:  # diagnosis only: the episode's start command appended to the hand state
             if int(u.elapsed_steps[0]) == 0:
@@ -137,12 +139,18 @@ def main(argv=None) -> int:
     ap.add_argument("--clock", action="store_true",
                     help="diagnosis only: the network also sees the gait's clock (sin and cos of its phase at the "
                          "control step); its checkpoint does not fit the UniCross observation and is not written")
-    ap.add_argument("--history", action="store_true",
-                    help="diagnosis only: the network also sees the previous control step's s^h (joint readings "
-                         "and command), as HORA's proprioceptive history; its checkpoint does not fit the UniCross "
-                         "observation and is not written")
+    ap.add_argument("--history", type=int, nargs="?", const=1, default=0, metavar="N",
+                    help="diagnosis only: the network also sees the previous N control steps' s^h (joint readings "
+                         "and command; N = 1 without a number), as HORA's proprioceptive history (30 steps there); "
+                         "its checkpoint does not fit the UniCross observation and is not written")
     ap.add_argument("--randomize", action="store_true", help="training's randomisation (default: the evaluation's conditions)")
     ap.add_argument("--grasps", default=None, help="grasp-state dataset the episodes start from (default: the shipped one)")
+    ap.add_argument("--heldout", type=int, default=0, metavar="LIMIT",
+                    help="then roll the kept network out alone on the first LIMIT objects per group of "
+                         "--heldout-objects x 3 trials, seed 0 (the trials of `unicross eval ... --limit LIMIT "
+                         "--trials-per-object 3 --seed 0`; 20: the 120-trial held-out cell), written to "
+                         "OUT/heldout.json; also for diagnosis runs, whose networks no checkpoint can hold (0: skip)")
+    ap.add_argument("--heldout-objects", default="test")
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--out", required=True)
@@ -152,6 +160,7 @@ def main(argv=None) -> int:
     from unicross.config import load_config
     from unicross.gaits import gait_mode, make_gait_policy
     from unicross.grasps import grasp_dataset_file
+    from unicross.metrics import wilson_interval
     from unicross.rl.models import make_models
     from unicross.rl.ppo import env_kwargs_for
     from unicross.rl.runner import git_commit
@@ -270,6 +279,22 @@ def main(argv=None) -> int:
         f.writelines(json.dumps(x) + "\n" for x in log)
     (out / "command.txt").write_text("python benchmarks/gait_clone.py " + " ".join(sys.argv[1:] if argv is None else argv)
                                      + f"  # commit {git_commit()}\n")
+    if args.heldout:
+        policy.load_state_dict(fitted[best]["state"])
+        with ProcessPoolExecutor(args.workers, mp_context=ctx) as ex:
+            parts = [f.result() for f in [ex.submit(_rollouts, args.gait, args.hand, args.heldout_objects, args.heldout,
+                                                     3, 0, False, actor, (i, args.workers), 0.0, args.privileged_q0,
+                                                     args.clock, args.history, args.sequence, mode, args.grasps)
+                                           for i in range(args.workers)]]
+        trials = sorted((t for p in parts for t in p[2]), key=lambda t: (t.get("object", ""), t.get("trial", 0)))
+        k, n = sum(bool(t["success"]) for t in trials), len(trials)
+        lo, hi = wilson_interval(k, n)
+        held = dict(objects=args.heldout_objects, limit=args.heldout, trials_per_object=3, seed=0, round=best,
+                    success=k, n=n, rate=k / n, wilson95=[lo, hi],
+                    dropped=sum(bool(t.get("dropped")) for t in trials), trials=trials)
+        (out / "heldout.json").write_text(json.dumps(held, default=float) + "\n")
+        print(f"held out ({args.heldout_objects}, first {args.heldout} per group x 3, seed 0): {k} of {n} "
+              f"({100 * k / n:.1f}% [{100 * lo:.1f}-{100 * hi:.1f}]), {held['dropped']} dropped", flush=True)
     what = "(not written: a diagnosis run)" if diagnosis else f"wrote {out / 'policy.pt'}:"
     print(f"{what} the network of round {best} ({100 * fitted[best]['success']:.1f}% "
           f"of its episodes; {time.time() - t0:.0f} s)")

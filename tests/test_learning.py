@@ -434,18 +434,27 @@ def test_init_policy_brings_its_input_floor(tmp_path):
 @pytest.mark.slow
 def test_gait_clone_writes_a_policy_that_loads_and_logs_its_fresh_error(tmp_path):
     """benchmarks/gait_clone.py end to end at its smallest (one object per group, one round): a
-    policy checkpoint the evaluation loads, and a log whose network round has ``fresh_mse``."""
+    policy checkpoint the evaluation loads, a log whose network round has ``fresh_mse``, and a held-out
+    file (``--heldout``) with the trials `unicross eval` gives that checkpoint."""
     import json
     import subprocess
     import sys
     from pathlib import Path
-    from unicross.evaluation import resolve_policy
+    from unicross.evaluation import resolve_policy, run_protocol
+    from unicross.objects import get_object_set
     script = Path(__file__).resolve().parent.parent / "benchmarks" / "gait_clone.py"
     out = tmp_path / "clone"
     subprocess.run([sys.executable, str(script), "--gait", "allegro/rotate_y-,tracking=phase,lookahead=1.5",
-                    "--limit", "1", "--trials", "1", "--rounds", "1", "--workers", "1", "--out", str(out)],
-                   check=True, timeout=900)
+                    "--limit", "1", "--trials", "1", "--rounds", "1", "--workers", "1", "--heldout", "1",
+                    "--out", str(out)], check=True, timeout=900)
     rows = [json.loads(line) for line in (out / "log.jsonl").read_text().splitlines()]
     assert rows[0]["actor"] == "gait" and rows[1]["actor"] == "network" and rows[1]["fresh_mse"] >= 0
-    _, desc = resolve_policy(str(out / "policy.pt"), "allegro")
+    policy, desc = resolve_policy(str(out / "policy.pt"), "allegro")
     assert desc["kind"] != "gait"
+    held = json.loads((out / "heldout.json").read_text())
+    trials = run_protocol("rotate", policy, get_object_set("test", limit=1), trials_per_object=3, seed=0,
+                          axes=["y-"], progress=False)
+    assert held["n"] == len(trials) == len(held["trials"])
+    key = lambda t: (t["object"], t["trial"])  # noqa: E731
+    assert [(key(t), t["success"], t["steps"]) for t in sorted(held["trials"], key=key)] == \
+        [(key(t), t["success"], t["steps"]) for t in sorted(trials, key=key)]
