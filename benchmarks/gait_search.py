@@ -83,7 +83,7 @@ import time
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-from unicross.gaits import gait_targets, layout_of  # noqa: E402
+from unicross.gaits import gait_offsets, gait_period, gait_targets, layout_of  # noqa: E402
 _ENVS = {}
 
 
@@ -136,12 +136,22 @@ def episode(job) -> list:
                 p[6 * f: 6 * f + 3] = 0.0
     q0 = u.command[0, 6:].clone()
     x0 = u.cur_rel.x_oh[0].clone()
+    if job.get("tracking", "clock") == "phase":  # the cycle sampled 8 times a step (unicross.gaits.make_gait_policy's grid)
+        period = gait_period(p)
+        taus = torch.arange(int(math.ceil(period * 8))) / 8
+        taus = taus[taus < period]
+        cycle = gait_offsets(p, taus, layout=layout)
     rot = torch.zeros(3)
     dropped, steps, exceeded = False, 0, False
     for t in range(job["steps"]):
         a = torch.zeros(1, u.action_scale.shape[0])
         if not exceeded:
-            a[0, 6:] = ((gait_targets(p, t + 1, q0, layout) - u.command[0, 6:]) / u.action_scale[6:]).clamp(-1, 1)
+            if job.get("tracking", "clock") == "phase":  # lookahead steps past the cycle's point nearest the command
+                k = ((cycle - (u.command[0, 6:] - q0)) ** 2).sum(-1).argmin()
+                target = q0 + gait_offsets(p, taus[k:k + 1] + job["lookahead"], layout=layout)[0]
+            else:
+                target = gait_targets(p, t + 1, q0, layout)
+            a[0, 6:] = ((target - u.command[0, 6:]) / u.action_scale[6:]).clamp(-1, 1)
         _, _, term, trunc, _ = u.step(a)
         steps += 1
         if bool(term[0]) or bool(u.ever_dropped[0]):
@@ -167,7 +177,7 @@ def evaluate(pool, gaits, args, n_obj, first: int = 0, hold=None, seeds=None, pa
     jobs = [dict(p=p.tolist(), oi=oi, seed=trial_seed(0, oi, k), hand=args.hand, skill=args.skill, axis=args.axis,
                  objects=args.objects, limit=args.limit, randomize=not args.no_randomize, steps=args.steps,
                  amplitude=args.amplitude, finger=(first + i) % n_fingers if args.one_finger else None, hold=hold,
-                 grasps=args.grasps)
+                 grasps=args.grasps, tracking=args.tracking, lookahead=args.lookahead)
             for i, p in enumerate(gaits) for oi, k in pairs]
     return np.array(pool.map(episode, jobs, chunksize=1)).reshape(len(gaits), len(pairs), 9)
 
@@ -267,6 +277,11 @@ def main():
                          "to --steps; score = the protocol's success (exceeded, never dropped)")
     ap.add_argument("--grasps", default=None,
                     help="grasp-state dataset the episodes start from (default: the shipped one, the grasp expert's)")
+    ap.add_argument("--tracking", default="clock", choices=["clock", "phase"],
+                    help="how each gait is run and scored (unicross.gaits.make_gait_policy): clock, as searched so far, "
+                         "or phase (the target --lookahead steps past the cycle's point nearest the joint command, a "
+                         "function of the state); logged in the rows' meta, which the gait then runs with")
+    ap.add_argument("--lookahead", type=float, default=1.5, help="--tracking phase: control steps ahead on the cycle")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--out", default=None)
     ap.add_argument("--summary", nargs="+", default=None)

@@ -119,6 +119,16 @@ def test_phase_tracking_follows_the_cycle_from_wherever_the_fingers_are(tmp_path
         assert not torch.allclose(clock(None, u)[:, 6:] * 10.0, move, atol=1e-3)  # the clock's target differs
     with pytest.raises(ValueError, match="tracking"):
         make_gait_policy(str(tmp_path / "log.jsonl"), tracking="nearest")
+    # a gait searched with phase tracking (its log's meta: gait_search.py --tracking phase) runs with it
+    _write(tmp_path / "phase.jsonl", [dict(meta=dict(amplitude=1.0, tracking="phase", lookahead=1.0), p=p, score=1.0)])
+    searched = make_gait_policy(str(tmp_path / "phase.jsonl"), grid=2)
+    u.elapsed_steps[:] = 0
+    u.command[:, 6:] = q0
+    searched(None, u)
+    u.command[:, 6:] = q0 + gait_offsets(p, torch.tensor(2.0))
+    u.elapsed_steps[:] = 5
+    want = gait_offsets(p, torch.tensor(3.0)) - gait_offsets(p, torch.tensor(2.0))
+    torch.testing.assert_close(searched(None, u)[0, 6:] * 10.0, want, atol=1e-5, rtol=0)
 
 
 def test_gait_options_ride_in_the_spec(tmp_path):

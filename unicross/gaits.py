@@ -263,6 +263,10 @@ def make_gait_policy(spec: str, tracking: str = "clock", lookahead: float = 1.0,
     if reverse not in (0, 1):
         raise ValueError(f"gait reverse must be 0 or 1, got {reverse}")
     p, row = best_gait(resolve_gait(spec))
+    searched = row.get("meta", {})  # a gait searched with phase tracking runs with it unless the spec says otherwise
+    if "tracking" not in opts and searched.get("tracking", "clock") != "clock":
+        tracking = searched["tracking"]
+        lookahead = opts.get("lookahead", searched.get("lookahead", lookahead))
     if reverse:  # a gait for the opposite direction of the same axis
         p = reverse_gait(p)
         mode = gait_mode(row)
