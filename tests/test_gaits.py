@@ -148,7 +148,9 @@ def test_gait_options_ride_in_the_spec(tmp_path):
     u.elapsed_steps[:] = 0
     phase = make_gait_policy("allegro/rotate_y-,tracking=phase,lookahead=1.5")(None, u)
     assert torch.equal(phase, make_gait_policy("allegro/rotate_y-", tracking="phase", lookahead=1.5)(None, u))
-    assert not torch.equal(phase, make_gait_policy("allegro/rotate_y-")(None, u))
+    assert not torch.equal(phase, make_gait_policy("allegro/rotate_y-,tracking=clock")(None, u))
+    # the shipped y- gait was searched with phase tracking at lookahead 1.5 (its meta): that is how it runs by default
+    assert torch.equal(phase, make_gait_policy("allegro/rotate_y-")(None, u))
 
 
 def test_a_reversed_gait_runs_the_same_loop_backwards_and_is_a_gait_for_the_opposite_direction(tmp_path):
@@ -165,8 +167,8 @@ def test_a_reversed_gait_runs_the_same_loop_backwards_and_is_a_gait_for_the_oppo
         assert not torch.allclose(gait_offsets(q, t), gait_offsets(p, t), atol=1e-3)
         assert torch.allclose(reverse_gait(q), p, atol=1e-6)
         assert q.min() >= -1 and q.max() <= 1
-    forward = make_gait_policy("allegro/rotate_y-")
-    backward = make_gait_policy("allegro/rotate_y-,reverse=1")
+    forward = make_gait_policy("allegro/rotate_y-,tracking=clock")  # the clock: its first target is the gait's at t = 1
+    backward = make_gait_policy("allegro/rotate_y-,reverse=1,tracking=clock")
     assert forward.gait_row["mode"] == "rotate_y-"
     assert backward.gait_row["mode"] == "rotate_y+" and backward.gait_row["reversed_from"] == "rotate_y-"
     (tmp_path / "reversed.jsonl").write_text(json.dumps(backward.gait_row) + "\n")  # the row an eval records
