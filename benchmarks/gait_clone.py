@@ -198,14 +198,17 @@ def main(argv=None) -> int:
     def beta_of(r: int) -> float:  # the last round measures the network alone
         return 0.0 if r in (0, args.rounds) else args.beta ** r
 
-    for r in range(args.rounds + 1):
-        student = None if r == 0 else actor
+    def collect(objects: str, limit: int, trials: int, seed: int, randomize: bool, student, beta: float) -> list:
+        """Every worker's :func:`_rollouts` of one round (or of the held-out evaluation)."""
         with ProcessPoolExecutor(args.workers, mp_context=ctx) as ex:
-            parts = [f.result() for f in [ex.submit(_rollouts, args.gait, args.hand, args.objects, args.limit,
-                                                     args.trials, args.seed + 7919 * r, args.randomize, student,
-                                                     (i, args.workers), beta_of(r), args.privileged_q0,
-                                                     args.clock, args.history, args.sequence, mode, args.grasps)
-                                           for i in range(args.workers)]]
+            return [f.result() for f in [ex.submit(_rollouts, args.gait, args.hand, objects, limit, trials, seed,
+                                                    randomize, student, (i, args.workers), beta, args.privileged_q0,
+                                                    args.clock, args.history, args.sequence, mode, args.grasps)
+                                          for i in range(args.workers)]]
+
+    for r in range(args.rounds + 1):
+        parts = collect(args.objects, args.limit, args.trials, args.seed + 7919 * r, args.randomize,
+                        None if r == 0 else actor, beta_of(r))
         o = {k: torch.cat([p[0][k] for p in parts]) for k in parts[0][0]}
         y = torch.cat([p[1] for p in parts])
         trials = [t for p in parts for t in p[2]]
@@ -281,11 +284,7 @@ def main(argv=None) -> int:
                                      + f"  # commit {git_commit()}\n")
     if args.heldout:
         policy.load_state_dict(fitted[best]["state"])
-        with ProcessPoolExecutor(args.workers, mp_context=ctx) as ex:
-            parts = [f.result() for f in [ex.submit(_rollouts, args.gait, args.hand, args.heldout_objects, args.heldout,
-                                                     3, 0, False, actor, (i, args.workers), 0.0, args.privileged_q0,
-                                                     args.clock, args.history, args.sequence, mode, args.grasps)
-                                           for i in range(args.workers)]]
+        parts = collect(args.heldout_objects, args.heldout, 3, 0, False, actor, 0.0)
         trials = sorted((t for p in parts for t in p[2]), key=lambda t: (t.get("object", ""), t.get("trial", 0)))
         k, n = sum(bool(t["success"]) for t in trials), len(trials)
         lo, hi = wilson_interval(k, n)

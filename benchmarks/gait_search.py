@@ -83,7 +83,7 @@ import time
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-from unicross.gaits import gait_offsets, gait_period, gait_targets, layout_of  # noqa: E402
+from unicross.gaits import gait_targets, layout_of, phase_cycle, phase_offsets  # noqa: E402
 _ENVS = {}
 
 
@@ -136,19 +136,16 @@ def episode(job) -> list:
                 p[6 * f: 6 * f + 3] = 0.0
     q0 = u.command[0, 6:].clone()
     x0 = u.cur_rel.x_oh[0].clone()
-    if job.get("tracking", "clock") == "phase":  # the cycle sampled 8 times a step (unicross.gaits.make_gait_policy's grid)
-        period = gait_period(p)
-        taus = torch.arange(int(math.ceil(period * 8))) / 8
-        taus = taus[taus < period]
-        cycle = gait_offsets(p, taus, layout=layout)
+    phase = job.get("tracking", "clock") == "phase"
+    if phase:  # the cycle as unicross.gaits.make_gait_policy samples it (8 times a control step)
+        taus, cycle = phase_cycle(p, 8, layout)
     rot = torch.zeros(3)
     dropped, steps, exceeded = False, 0, False
     for t in range(job["steps"]):
         a = torch.zeros(1, u.action_scale.shape[0])
         if not exceeded:
-            if job.get("tracking", "clock") == "phase":  # lookahead steps past the cycle's point nearest the command
-                k = ((cycle - (u.command[0, 6:] - q0)) ** 2).sum(-1).argmin()
-                target = q0 + gait_offsets(p, taus[k:k + 1] + job["lookahead"], layout=layout)[0]
+            if phase:
+                target = q0 + phase_offsets(p, taus, cycle, u.command[:, 6:] - q0, job["lookahead"], layout)[0]
             else:
                 target = gait_targets(p, t + 1, q0, layout)
             a[0, 6:] = ((target - u.command[0, 6:]) / u.action_scale[6:]).clamp(-1, 1)

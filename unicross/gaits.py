@@ -122,6 +122,23 @@ def gait_targets(p, t: int, q0: torch.Tensor, layout: GaitLayout = ALLEGRO_LAYOU
     return q0 + gait_offsets(p, float(t), torch.float64, layout).to(q0.device)
 
 
+def phase_cycle(p, grid: int = 8, layout: GaitLayout = ALLEGRO_LAYOUT):
+    """One period of gait ``p`` sampled ``grid`` times per control step: (times [K], offsets [K, n_joints]),
+    what phase tracking (:func:`make_gait_policy`, ``tracking=phase``) finds the hand on."""
+    period = gait_period(p)
+    taus = torch.arange(int(math.ceil(period * grid))) / grid
+    taus = taus[taus < period]
+    return taus, gait_offsets(p, taus, layout=layout)
+
+
+def phase_offsets(p, taus: torch.Tensor, cycle: torch.Tensor, rel: torch.Tensor, ahead,
+                  layout: GaitLayout = ALLEGRO_LAYOUT) -> torch.Tensor:
+    """Phase tracking's target offsets [N, n_joints]: ``ahead`` control steps (a number or [N]) past the point of
+    the cycle (:func:`phase_cycle`) nearest the command's offsets ``rel`` [N, n_joints] from the gait's centre."""
+    k = ((cycle[None] - rel[:, None]) ** 2).sum(-1).argmin(1)  # [N]
+    return gait_offsets(p, taus[k] + ahead, layout=layout)
+
+
 def gait_hand(row: dict) -> str:
     """The hand a gait was searched for: a shipped gait's ``hand``, else its log's ``meta.hand``
     (Allegro for the logs written before searches named one)."""
@@ -275,9 +292,7 @@ def make_gait_policy(spec: str, tracking: str = "clock", lookahead: float = 1.0,
     hand = gait_hand(row)
     layout = layout_of(hand)
     _check_length(p, layout)
-    period = gait_period(p)
-    taus = torch.arange(int(math.ceil(period * grid))) / grid
-    cycle = gait_offsets(p, taus[taus < period], layout=layout)  # [K, n_joints] offsets over one period
+    taus, cycle = phase_cycle(p, grid, layout)
     state = {}
 
     def policy(obs, u):
@@ -314,10 +329,9 @@ def make_gait_policy(spec: str, tracking: str = "clock", lookahead: float = 1.0,
             else:
                 target = gait_targets(p, t + 1, state["q0"], layout)
         else:
-            rel = u.command[:, 6:] - centre  # [N, n_joints]
-            k = ((cycle.to(u.device)[None] - rel[:, None]) ** 2).sum(-1).argmin(1)  # [N]
             ahead = torch.where(slipping, 0.0, lookahead) if guard > 0 else lookahead
-            target = centre + gait_offsets(p, taus.to(u.device)[k] + ahead, layout=layout)
+            target = centre + phase_offsets(p, taus.to(u.device), cycle.to(u.device), u.command[:, 6:] - centre,
+                                            ahead, layout)
         step = ((target - u.command[:, 6:]) / u.action_scale[6:]).clamp(-1, 1)
         a[:, 6:] = torch.where(state["done"][:, None], torch.zeros_like(step), step)
         return a
