@@ -36,7 +36,9 @@ the object has turned past the success angle about the axis (the fingers hold th
 from the task's state) and the episode runs on to ``--steps`` (400: the protocol's); an episode
 scores 1 for a success (passed, never dropped), half its turn in success angles otherwise, -0.5 for
 a drop. With ``--init`` the first generation is the 16 logged gaits that turned the object furthest
-about the axis; the search goes on from the best of them. ``--select N`` re-runs the N best
+about the axis; the search goes on from the best of them. ``--no-stop`` scores the same success while the
+gait keeps cycling after it (no privileged stop: the gait a network can copy, ``benchmarks/gait_clone.py``).
+``--select N`` re-runs the N best
 distinct gaits on ``--select-seeds`` new starts per object and logs their success rate: the gait
 that ``unicross eval --policy gait:LOG`` runs (:mod:`unicross.gaits`). The shipped rotate gaits:
 
@@ -122,7 +124,8 @@ def episode(job) -> list:
 
     With ``job["hold"]`` = (component, sign, threshold) the gait stops for good once the motion about
     or along that signed axis exceeds the threshold (the fingers hold their targets from then on) and
-    the episode runs on to ``steps``: the protocol's "exceeded, never dropped" (``exceeded`` = 1)."""
+    the episode runs on to ``steps``: the protocol's "exceeded, never dropped" (``exceeded`` = 1); with
+    ``job["no_stop"]`` the gait goes on cycling after that (``exceeded`` is still recorded)."""
     import torch
     torch.set_num_threads(1)
     u = _env(job)
@@ -143,7 +146,7 @@ def episode(job) -> list:
     dropped, steps, exceeded = False, 0, False
     for t in range(job["steps"]):
         a = torch.zeros(1, u.action_scale.shape[0])
-        if not exceeded:
+        if not exceeded or job.get("no_stop"):
             if phase:
                 target = q0 + phase_offsets(p, taus, cycle, u.command[:, 6:] - q0, job["lookahead"], layout)[0]
             else:
@@ -174,7 +177,7 @@ def evaluate(pool, gaits, args, n_obj, first: int = 0, hold=None, seeds=None, pa
     jobs = [dict(p=p.tolist(), oi=oi, seed=trial_seed(0, oi, k), hand=args.hand, skill=args.skill, axis=args.axis,
                  objects=args.objects, limit=args.limit, randomize=not args.no_randomize, steps=args.steps,
                  amplitude=args.amplitude, finger=(first + i) % n_fingers if args.one_finger else None, hold=hold,
-                 grasps=args.grasps, tracking=args.tracking, lookahead=args.lookahead)
+                 grasps=args.grasps, tracking=args.tracking, lookahead=args.lookahead, no_stop=args.no_stop)
             for i, p in enumerate(gaits) for oi, k in pairs]
     return np.array(pool.map(episode, jobs, chunksize=1)).reshape(len(gaits), len(pairs), 9)
 
@@ -272,6 +275,10 @@ def main():
     ap.add_argument("--hold", action="store_true",
                     help="--refine: the gait stops once the motion exceeds the success threshold, the fingers hold "
                          "to --steps; score = the protocol's success (exceeded, never dropped)")
+    ap.add_argument("--no-stop", action="store_true",
+                    help="--hold: score the protocol's success as --hold does, but the gait never stops: it keeps "
+                         "cycling for all --steps (no privileged read of the object's motion), as a policy that sees "
+                         "only the observation would; logged in the rows' meta, which the gait then runs with (stop=0)")
     ap.add_argument("--grasps", default=None,
                     help="grasp-state dataset the episodes start from (default: the shipped one, the grasp expert's)")
     ap.add_argument("--tracking", default="clock", choices=["clock", "phase"],
@@ -287,6 +294,8 @@ def main():
         return summary(args.summary)
     if args.out is None:
         ap.error("--out is required")
+    if args.no_stop and not args.hold:
+        ap.error("--no-stop scores the protocol's success: it needs --hold (and --refine)")
     args.axis = args.axis or ("z-" if args.skill == "translate" else "x+")
     args.objects = args.objects or ("train-elongated" if args.skill == "translate" else "train-wrappable")
     from multiprocessing import get_context

@@ -74,6 +74,33 @@ def test_the_policy_runs_the_gait_until_the_object_has_turned_past_the_angle_the
     assert bool((policy(None, u)[0, 6:].abs().sum() > 0))
 
 
+def test_without_the_stop_the_gait_keeps_cycling_past_the_angle(tmp_path):
+    """``stop=0`` (or a log searched with ``gait_search.py --no-stop``): no privileged stop, the gait goes on
+    for the whole episode after the object has passed the success angle; ``stop=1`` in the spec restores it."""
+    g = torch.Generator().manual_seed(0)
+    p = (torch.rand(NPAR, generator=g) * 2 - 1).tolist()
+    _write(tmp_path / "log.jsonl", [dict(meta=dict(amplitude=1.0), p=p, score=1.0)])
+    _write(tmp_path / "nostop.jsonl", [dict(meta=dict(amplitude=1.0, no_stop=True), p=p, score=1.0)])
+    policies = {name: make_gait_policy(spec) for name, spec in
+                (("stop", str(tmp_path / "log.jsonl")), ("spec", f"{tmp_path / 'log.jsonl'},stop=0"),
+                 ("log", str(tmp_path / "nostop.jsonl")), ("log_stop", f"{tmp_path / 'nostop.jsonl'},stop=1"))}
+    envs = {name: _stand_in_env(1, "rotate_y-", [0.0, -1.0, 0.0]) for name in policies}
+    steps_to_pass = math.floor(envs["stop"].cfg["success"]["rotate_angle"] / 0.05) + 1
+    for t in range(steps_to_pass + 3):
+        moving = {}
+        for name, policy in policies.items():
+            u = envs[name]
+            u.elapsed_steps[:] = t
+            a = policy(None, u)
+            moving[name] = bool(a[0, 6:].abs().sum() > 0)
+            u.command[:, 6:] += a[:, 6:] * u.action_scale[6:]
+            u.obj_angvel_h[0] = torch.tensor([0.0, -1.0, 0.0])
+        assert moving["spec"] and moving["log"]  # past the angle too
+        assert moving["stop"] == moving["log_stop"] == (t < steps_to_pass)
+    with pytest.raises(ValueError, match="stop must be 0 or 1"):
+        make_gait_policy(f"{tmp_path / 'log.jsonl'},stop=2")
+
+
 def test_gait_policies_refuse_other_hands(tmp_path):
     from unicross.evaluation import resolve_policy
     _write(tmp_path / "log.jsonl", [dict(meta=dict(skill="rotate", refine="z+"), p=[0.0] * NPAR, score=0.0)])

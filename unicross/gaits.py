@@ -157,12 +157,13 @@ def layout_of(hand: str) -> GaitLayout:
 SHIPPED_DIR = Path(__file__).resolve().parent / "checkpoints"
 
 
-GAIT_OPTIONS = {"tracking": str, "lookahead": float, "grid": int, "reverse": int, "guard": int, "guard_max": float}
+GAIT_OPTIONS = {"tracking": str, "lookahead": float, "grid": int, "reverse": int, "guard": int, "guard_max": float,
+                "stop": int}
 
 
 def split_gait_spec(spec: str) -> Tuple[str, dict]:
     """(gait, options) of ``GAIT[,key=value...]``, the options of :func:`make_gait_policy`
-    (``tracking``, ``lookahead``, ``grid``, ``reverse``, ``guard``, ``guard_max``), e.g. ``allegro/rotate_y-,tracking=phase,lookahead=1.5``
+    (``tracking``, ``lookahead``, ``grid``, ``reverse``, ``guard``, ``guard_max``, ``stop``), e.g. ``allegro/rotate_y-,tracking=phase,lookahead=1.5``
     or ``allegro/rotate_y-,reverse=1`` (the y- gait run backwards, :func:`reverse_gait`)."""
     base, *rest = spec.split(",")
     opts = {}
@@ -241,7 +242,7 @@ GUARD_RATE = 0.02  # rad a control step along the closing direction while a guar
 
 
 def make_gait_policy(spec: str, tracking: str = "clock", lookahead: float = 1.0, grid: int = 8, reverse: int = 0,
-                     guard: int = 0, guard_max: float = 0.15):
+                     guard: int = 0, guard_max: float = 0.15, stop: int = 1):
     """The scripted in-hand policy of the best gait in ``spec`` (a log, or a shipped gait's
     ``<hand>/<mode>``; see the module docstring). Options written into ``spec`` after commas
     (``allegro/rotate_y-,tracking=phase,lookahead=1.5``; :func:`split_gait_spec`) override the
@@ -266,11 +267,20 @@ def make_gait_policy(spec: str, tracking: str = "clock", lookahead: float = 1.0,
     lookahead, stands still) and the fingers close along the hand's closing direction by
     ``GUARD_RATE`` a step, up to ``guard_max`` rad in all; the gait then goes on around the tightened
     grasp (the tightening stays).
+
+    ``stop=0``: the gait never stops (no privileged read of the object's motion): it keeps cycling for
+    the whole episode, as the paper's policies keep turning. Its action is then a function of the
+    command and q0 alone (with ``tracking=phase``), with no unobservable switch to standing still,
+    which is what a network that sees only the observation can copy (``benchmarks/gait_clone.py``).
+    A gait searched with ``gait_search.py --no-stop`` runs this way unless the spec says ``stop=1``.
     """
     spec, opts = split_gait_spec(spec)
     tracking, lookahead, grid = opts.get("tracking", tracking), opts.get("lookahead", lookahead), opts.get("grid", grid)
     reverse = opts.get("reverse", reverse)
     guard, guard_max = opts.get("guard", guard), opts.get("guard_max", guard_max)
+    stop = opts.get("stop", stop)
+    if stop not in (0, 1):
+        raise ValueError(f"gait stop must be 0 or 1, got {stop}")
     if guard < 0 or guard_max < 0:
         raise ValueError(f"gait guard and guard_max must be >= 0, got {guard} and {guard_max}")
     if tracking not in TRACKING:
@@ -284,6 +294,8 @@ def make_gait_policy(spec: str, tracking: str = "clock", lookahead: float = 1.0,
     if "tracking" not in opts and searched.get("tracking", "clock") != "clock":
         tracking = searched["tracking"]
         lookahead = opts.get("lookahead", searched.get("lookahead", lookahead))
+    if "stop" not in opts and searched.get("no_stop"):  # a gait searched without the stop runs without it
+        stop = 0
     if reverse:  # a gait for the opposite direction of the same axis
         p = reverse_gait(p)
         mode = gait_mode(row)
@@ -314,7 +326,8 @@ def make_gait_policy(spec: str, tracking: str = "clock", lookahead: float = 1.0,
         else:  # the motion of the step just taken, about / along the env's axis
             vel = torch.where(state["is_rot"][:, None], u.obj_angvel_h, u.obj_vel_h)
             state["motion"] += (vel * u.axis).sum(-1) * u.control_dt
-        state["done"] |= state["motion"] > state["threshold"]
+        if stop:
+            state["done"] |= state["motion"] > state["threshold"]
         a = torch.zeros(u.num_envs, u.hand_spec.dof, device=u.device)
         centre = state["q0"]  # the gait's centre: the start command, tightened by the guard
         if guard > 0:
