@@ -126,7 +126,8 @@ def test_a_checkpoint_on_top_of_a_gait_is_named_so_in_the_tables(tmp_path):
     torch.save(ck, tmp_path / "r.pt")
     assert policy_label(str(tmp_path / "r.pt")) == f"{tmp_path / 'r.pt'} (PPO on top of gait:allegro/rotate_y-)"
     # a network cloned from a gait (benchmarks/gait_clone.py records its gait) is not called a PPO expert
-    assert policy_label("allegro/rotate_y-") == "allegro/rotate_y- (DAgger clone of gait:allegro/rotate_y-, not PPO)"
+    # (since 2026-12-01 the shipped y- clone is of the gait run without its stop: its label says so)
+    assert policy_label("allegro/rotate_y-") == "allegro/rotate_y- (DAgger clone of gait:allegro/rotate_y-,stop=0, not PPO)"
 
 
 def test_training_budget_reads_every_shipped_sidecar():

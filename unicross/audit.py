@@ -241,7 +241,7 @@ def _gait(spec: str):
 def behaviours(skill: str, seed: int = 0, axis: Optional[str] = None, hand: str = "allegro") -> Dict[str, Callable]:
     """name -> factory(u) -> act() for the reference behaviours of ``skill``; the first is the
     successful reference. With ``axis``, a mode with a shipped scripted gait (:mod:`unicross.gaits`)
-    also lists it as ``gait``, and one with a physical reference not listed already (translate z-:
+    also lists it as ``gait`` (and run without its privileged stop, ``stop=0``, as ``gait_nostop``), and one with a physical reference not listed already (translate z-:
     ``pull``) lists that."""
     common = dict(zero=_zero, random=_random_factory(seed))
     if skill == "grasp":
@@ -255,7 +255,8 @@ def behaviours(skill: str, seed: int = 0, axis: Optional[str] = None, hand: str 
     if skill in ("rotate", "translate"):
         from unicross.gaits import shipped_gaits
         gait = shipped_gaits(hand).get(f"{skill}_{axis}") if axis else None
-        beh = dict(oracle=_oracle, **(dict(gait=_gait(gait)) if gait else {}), zero=common["zero"],
+        gaits = dict(gait=_gait(gait), gait_nostop=_gait(f"{gait},stop=0")) if gait else {}  # with / without its stop
+        beh = dict(oracle=_oracle, **gaits, zero=common["zero"],
                    open=_finger_sweep(-0.02), close=_finger_sweep(0.02), random=common["random"])
         ref = PHYSICAL_REFERENCES.get((skill, axis))
         if ref:
