@@ -171,10 +171,29 @@ def test_success_bonus_is_taken_back_at_a_drop_where_configured():
     assert cfg["success_revoke_on_drop"]["rotate"] and not cfg["success_revoke_on_drop"]["translate"]
     c = RW.RewardTerms(cfg, "cpu").coefficients("success")
     m = dict(success=torch.tensor([False, False, True, False]), drop=torch.tensor([True, True, False, True]),
-             held=torch.tensor([True, False, True, True]), success_paid=torch.tensor([120.0, 120.0, 30.0, 120.0]))
+             held=torch.tensor([True, False, True, True]), success_paid=torch.tensor([120.0, 120.0, 30.0, 120.0]),
+             goal_err=torch.full((4, 2), 0.5))
     rot = torch.tensor([F.MODES.index("rotate_y-")] * 3 + [F.MODES.index("translate_z+")])
     w = cfg["success"]["rotate"]
     assert RW.success_reward(m, c, rot).tolist() == [-120.0, 0.0, w, 0.0]
+
+
+def test_success_bonus_can_require_the_object_near_its_goal_position():
+    """``success_max_pos_error``: the bonus is paid only while the object is within d of its final
+    root-frame position (inf, the default, pays it wherever the object is); the take-back at a drop
+    is unchanged."""
+    assert set(load_config("reward")["success_max_pos_error"].values()) == {float("inf")}
+    cfg = load_config("reward", {"success_max_pos_error": {"rotate": 0.04}})
+    c = RW.RewardTerms(cfg, "cpu").coefficients("success")
+    goal_err = torch.tensor([[0.05, 0.0], [0.03, 0.0], [0.10, 0.0], [0.50, 0.0]])  # [position, angle]
+    m = dict(success=torch.ones(4, dtype=torch.bool), drop=torch.tensor([False, False, True, False]),
+             held=torch.ones(4, dtype=torch.bool), success_paid=torch.tensor([0.0, 0.0, 50.0, 0.0]),
+             goal_err=goal_err)
+    mode = torch.tensor([F.MODES.index("rotate_y-")] * 3 + [F.MODES.index("translate_z+")])
+    w = cfg["success"]["rotate"]
+    # an object rolled 5 cm away earns nothing; translate (no gate) is paid 50 cm from its goal;
+    # the drop takes back what was paid
+    assert RW.success_reward(m, c, mode).tolist() == [0.0, w, -50.0, cfg["success"]["translate"]]
 
 
 def test_progress_term_telescopes_to_the_error_reduction():

@@ -92,14 +92,17 @@ def motion_reward(m: dict, c: dict, mode: torch.Tensor) -> torch.Tensor:
 
 
 @reward_term("success", lambda cfg, dev: dict(w=per_mode(cfg["success"], dev),
-                                              revoke=per_mode(cfg["success_revoke_on_drop"], dev)))
+                                              revoke=per_mode(cfg["success_revoke_on_drop"], dev),
+                                              max_pos=per_mode(cfg["success_max_pos_error"], dev)))
 def success_reward(m: dict, c: dict, mode: torch.Tensor) -> torch.Tensor:
     """w_success · [the mode's success holds at this step], and with ``success_revoke_on_drop``
     minus everything this term has paid in the episode (``success_paid``, before this step) at the
     step the object is dropped: success counts only if the object is never dropped, so an episode
     that passes the threshold and then drops it nets no bonus."""
     first_drop = (m["drop"] & m["held"]).float()
-    return c["w"][mode] * m["success"].float() - c["revoke"][mode] * m["success_paid"] * first_drop
+    near = m["goal_err"][:, 0] <= c["max_pos"][mode]
+    return (c["w"][mode] * (m["success"] & near).float()
+            - c["revoke"][mode] * m["success_paid"] * first_drop)
 
 
 @reward_term("settle", lambda cfg, dev: dict(w=per_mode(cfg["settle"]["weight"], dev),
