@@ -241,8 +241,8 @@ def _gait(spec: str):
 def behaviours(skill: str, seed: int = 0, axis: Optional[str] = None, hand: str = "allegro") -> Dict[str, Callable]:
     """name -> factory(u) -> act() for the reference behaviours of ``skill``; the first is the
     successful reference. With ``axis``, a mode with a shipped scripted gait (:mod:`unicross.gaits`)
-    also lists it as ``gait`` (and run without its privileged stop, ``stop=0``, as ``gait_nostop``), and one with a physical reference not listed already (translate z-:
-    ``pull``) lists that."""
+    also lists it as ``gait`` (and run without its privileged stop, ``stop=0``, as ``gait_nostop``),
+    and one with a physical reference not listed already (translate z-: ``pull``) lists that."""
     common = dict(zero=_zero, random=_random_factory(seed))
     if skill == "grasp":
         return dict(scripted=_grasp_script(lift=True, close=True, descend=True),
