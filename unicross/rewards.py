@@ -98,7 +98,9 @@ def success_reward(m: dict, c: dict, mode: torch.Tensor) -> torch.Tensor:
     """w_success · [the mode's success holds at this step], and with ``success_revoke_on_drop``
     minus everything this term has paid in the episode (``success_paid``, before this step) at the
     step the object is dropped: success counts only if the object is never dropped, so an episode
-    that passes the threshold and then drops it nets no bonus."""
+    that passes the threshold and then drops it nets no bonus. With ``success_max_pos_error`` (inf by
+    default) the bonus is paid only while the object is within that distance of its final root-frame
+    position (``goal_err[:, 0]``), so an object turned by rolling away on an open hand earns none."""
     first_drop = (m["drop"] & m["held"]).float()
     near = m["goal_err"][:, 0] <= c["max_pos"][mode]
     return (c["w"][mode] * (m["success"] & near).float()
