@@ -416,14 +416,16 @@ def test_init_policy_brings_its_input_floor(tmp_path):
     Fails without the adoption: the run kept its configured floor and started from another policy."""
     from unicross.rl.policy_io import load_policy, resolve_checkpoint
     from unicross.rl.ppo import PPOTrainer
-    shipped = str(resolve_checkpoint("allegro/rotate_y-"))
+    shipped = str(resolve_checkpoint("allegro/rotate_z+"))
     ref, ck = load_policy(shipped)
     assert ck["config"]["model"]["obs_std_min"] == 0.01  # the premise: the shipped clone has a floor
     over = dict(env=dict(num_envs=1, object_limit=1), collector=dict(total_frames=16, horizon=16),
                 model=dict(init_policy=shipped, obs_std_min=0.0), logging=dict(eval_trials=0, final_eval_trials=0))
-    t = PPOTrainer(tmp_path / "ry", "rotate", "y-", overrides=over, progress=False)
+    t = PPOTrainer(tmp_path / "rz", "rotate", "z+", overrides=over, progress=False)
     try:
         assert t.algo.norm.std_min == 0.01 and t.cfg["model"]["obs_std_min"] == 0.01
+        # the checkpoint records what the run started from (the tables call it PPO from a clone)
+        assert t.state()["started_from"] == dict(policy=shipped, clone_of=ck["clone_of"])
         g = torch.Generator().manual_seed(0)
         norm = ref.module[0].module.net.norm
         x = [getattr(norm, f"{k}_mean") + 0.01 * torch.randn(4, ck["obs_dims"][k], generator=g)

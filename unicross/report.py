@@ -50,12 +50,16 @@ def shipped(hand: str = "allegro") -> Dict[str, str]:
 def _gait_origin(ck: dict):
     """``("residual", gait)`` for a checkpoint that acts on top of a scripted gait
     (``model.base_policy``), ``("clone", gait)`` for a network cloned from one (``clone_of``, written
-    by ``benchmarks/gait_clone.py``), else None."""
+    by ``benchmarks/gait_clone.py``), ``("ppo_from_clone", gait)`` for PPO started from such a clone
+    (``model.init_policy``, recorded by the trainer as ``started_from``), else None."""
     from unicross.rl.policy_io import base_policy_of
     base = base_policy_of(ck)
     if base is not None:
         return "residual", base
-    return ("clone", ck["clone_of"]) if ck.get("clone_of") else None
+    if ck.get("clone_of"):
+        return "clone", ck["clone_of"]
+    start = (ck.get("started_from") or {}).get("clone_of")
+    return ("ppo_from_clone", start) if start else None
 
 
 def _scripted(clone_of: str) -> str:
@@ -65,13 +69,17 @@ def _scripted(clone_of: str) -> str:
 
 def policy_label(spec: str) -> str:
     """A checkpoint's name in the tables, saying so when it acts on top of a scripted gait or is a
-    network cloned from one rather than a PPO expert."""
+    network cloned from one rather than a PPO expert, or PPO started from such a clone."""
     from unicross.rl.policy_io import read_torch_file, resolve_checkpoint
     origin = _gait_origin(read_torch_file(resolve_checkpoint(spec), "checkpoint"))
     if origin is None:
         return spec
     how, gait = origin
-    return f"{spec} (PPO on top of gait:{gait})" if how == "residual" else f"{spec} (DAgger clone of {_scripted(gait)}, not PPO)"
+    if how == "residual":
+        return f"{spec} (PPO on top of gait:{gait})"
+    if how == "ppo_from_clone":
+        return f"{spec} (PPO from a DAgger clone of {_scripted(gait)})"
+    return f"{spec} (DAgger clone of {_scripted(gait)}, not PPO)"
 
 
 def how_trained(ck: dict) -> str:
@@ -82,7 +90,11 @@ def how_trained(ck: dict) -> str:
     origin = _gait_origin(ck)
     if origin is not None:
         how, gait = origin
-        return f"PPO on top of gait:{gait}" if how == "residual" else f"DAgger clone of {_scripted(gait)} (its search not counted)"
+        if how == "residual":
+            return f"PPO on top of gait:{gait}"
+        if how == "ppo_from_clone":
+            return f"PPO from a DAgger clone of {_scripted(gait)} (the clone's frames not counted)"
+        return f"DAgger clone of {_scripted(gait)} (its search not counted)"
     init = (ck.get("config") or {}).get("model", {}).get("init_reference")
     return f"PPO from a scripted start (model.init_reference {init:g})" if init else "PPO"
 

@@ -11,7 +11,7 @@ from unicross.rl.models import acting, make_models
 
 SHIPPED_DIR = Path(__file__).resolve().parent.parent / "checkpoints"
 SHIPPED_KEYS = ("policy", "obs_dims", "n_act", "modes", "distilled_modes", "config", "skill", "axis", "hand", "env_id",
-                "env_kwargs", "iteration", "epoch", "frames", "git_commit", "commits", "clone_of")
+                "env_kwargs", "iteration", "epoch", "frames", "git_commit", "commits", "clone_of", "started_from")
 
 
 def resolve_checkpoint(spec) -> Path:
@@ -54,7 +54,7 @@ def export_policy(run_checkpoint, out, sidecar: dict) -> Path:
     out.parent.mkdir(parents=True, exist_ok=True)
     torch.save(small, out)
     facts = {k: small[k] for k in ("skill", "axis", "hand", "iteration", "epoch", "frames", "distilled_modes",
-                                   "git_commit", "commits", "clone_of") if k in small}
+                                   "git_commit", "commits", "clone_of", "started_from") if k in small}
     out.with_suffix(".json").write_text(json.dumps({**facts, **sidecar}, indent=1) + "\n")
     return out
 

@@ -149,6 +149,10 @@ class PPOTrainer(Runner):
             start_policy = policy_to_start_from(cfg["model"]["init_policy"], skill, axis, hand,
                                                 cfg["model"].get("base_policy"))
             adopt_input_floor(cfg["model"], start_policy)
+        # what the run started from, kept in its checkpoints (a resumed run keeps its own record)
+        self.started_from = (self.ckpt or {}).get("started_from")
+        if start_policy is not None:
+            self.started_from = dict(policy=str(cfg["model"]["init_policy"]), clone_of=start_policy.get("clone_of"))
         obs_stats_frozen(cfg["model"])  # a bad model.obs_stats is refused before any simulation
         if self.ckpt is None and cfg["model"].get("init_reference") is not None:
             from unicross.audit import reference_action
@@ -223,7 +227,8 @@ class PPOTrainer(Runner):
         return dict(**self.algo.state_dict(), **self.runner_state(),
                     iteration=self.iteration, frames=self.frames, skill=self.skill,
                     axis=self.axis, hand=self.hand, env_id=self.env_id, env_kwargs=self.env_kwargs,
-                    obs_dims=self.dims, n_act=self.n_act, modes=list(F.MODES))
+                    obs_dims=self.dims, n_act=self.n_act, modes=list(F.MODES),
+                    **({"started_from": self.started_from} if self.started_from else {}))
 
     def _load_state(self, ck: dict):
         self.algo.load_state_dict(ck)
