@@ -67,6 +67,12 @@ def _scripted(clone_of: str) -> str:
     return clone_of if clone_of.startswith("seq:") else f"gait:{clone_of}"
 
 
+# how a checkpoint made from a scripted motion is named, and what its training budget leaves out
+_ORIGIN_NAMES = {"residual": ("PPO on top of {}", ""),
+                 "clone": ("DAgger clone of {}", " (its search not counted)"),
+                 "ppo_from_clone": ("PPO from a DAgger clone of {}", " (the clone's frames not counted)")}
+
+
 def policy_label(spec: str) -> str:
     """A checkpoint's name in the tables, saying so when it acts on top of a scripted gait or is a
     network cloned from one rather than a PPO expert, or PPO started from such a clone."""
@@ -74,27 +80,20 @@ def policy_label(spec: str) -> str:
     origin = _gait_origin(read_torch_file(resolve_checkpoint(spec), "checkpoint"))
     if origin is None:
         return spec
-    how, gait = origin
-    if how == "residual":
-        return f"{spec} (PPO on top of gait:{gait})"
-    if how == "ppo_from_clone":
-        return f"{spec} (PPO from a DAgger clone of {_scripted(gait)})"
-    return f"{spec} (DAgger clone of {_scripted(gait)}, not PPO)"
+    how, motion = origin
+    return f"{spec} ({_ORIGIN_NAMES[how][0].format(_scripted(motion))}{', not PPO' if how == 'clone' else ''})"
 
 
 def how_trained(ck: dict) -> str:
     """How a shipped checkpoint was made, from what it stores: a DAgger student, a network cloned
-    from a scripted gait, PPO on top of a gait, PPO from a scripted start, or PPO."""
+    from a scripted gait, PPO on top of a gait or from such a clone, PPO from a scripted start, or PPO."""
     if ck.get("distilled_modes"):
         return f"DAgger student of {len(ck['distilled_modes'])} experts"
     origin = _gait_origin(ck)
     if origin is not None:
-        how, gait = origin
-        if how == "residual":
-            return f"PPO on top of gait:{gait}"
-        if how == "ppo_from_clone":
-            return f"PPO from a DAgger clone of {_scripted(gait)} (the clone's frames not counted)"
-        return f"DAgger clone of {_scripted(gait)} (its search not counted)"
+        how, motion = origin
+        name, uncounted = _ORIGIN_NAMES[how]
+        return name.format(_scripted(motion)) + uncounted
     init = (ck.get("config") or {}).get("model", {}).get("init_reference")
     return f"PPO from a scripted start (model.init_reference {init:g})" if init else "PPO"
 
