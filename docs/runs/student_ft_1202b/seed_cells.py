@@ -1,0 +1,41 @@
+"""The student's test cells of the report for one candidate: the ten modes on held-out `test` objects and the long
+horizon (the same trials as docs/results.md: `PaperReport(limit=10, trials=3, min_trials=100, seed=0)`), for the
+other seeds of this stage, which report and do not choose (rule.txt).
+
+    python docs/runs/student_ft_1202b/seed_cells.py CHECKPOINT OUT.json
+
+Writes every cell's summary and prints the test successes summed over the ten modes and the long-horizon overall
+successes (the "test" and "long horizon" parts of clause (w), comparable with sum_cells.py on a report).
+"""
+import json
+import sys
+
+from unicross import formulation as F
+from unicross.evaluation import (chain_last_phase_by_mode, chain_table, resolve_policy, run_chain, sr_cell,
+                                 summarize_chain)
+from unicross.objects import get_object_set
+from unicross.report import PaperReport
+
+if __name__ == "__main__":
+    spec, out_path = sys.argv[1], sys.argv[2]
+    rep = PaperReport(hand="allegro", limit=10, trials=3, workers=2, seed=0, min_trials=100)
+    out = {"checkpoint": spec, "test": {}}
+    for mode in F.MODES:
+        cell = rep.evaluate(mode, spec, "test")
+        s = rep.summaries[(mode, spec, "test", False)]
+        out["test"][mode] = dict(cell=cell, summary=s)
+        print(mode, cell, flush=True)
+    # the long horizon exactly as PaperReport._chain runs it, keeping the summaries
+    objs = get_object_set("test", limit=rep.limit)
+    per_sequence = min(sum(o.category == c for o in objs) for c in {o.category for o in objs})
+    trials = run_chain(resolve_policy(spec, "allegro")[0], objs, hand="allegro",
+                       trials_per_object=rep.trials_per_object(per_sequence), seed=rep.seed, progress=False)
+    chains = summarize_chain(trials)
+    by_mode = {m: v for m, v in chain_last_phase_by_mode(trials).items()}
+    out["long_horizon"] = dict(summary=chains, in_hand_phase_by_mode=by_mode)
+    print(chain_table(chains), "\nIn-hand phase by mode:", "; ".join(f"{m} {sr_cell(v)}" for m, v in by_mode.items()),
+          flush=True)
+    out["test_successes"] = sum(c["summary"]["successes"] for c in out["test"].values())
+    out["long_horizon_successes"] = sum(c["overall"]["successes"] for c in chains.values())
+    json.dump(out, open(out_path, "w"), indent=1, default=float)
+    print(json.dumps({k: out[k] for k in ("test_successes", "long_horizon_successes")}))
