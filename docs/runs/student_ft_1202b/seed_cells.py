@@ -31,7 +31,7 @@ if __name__ == "__main__":
     trials = run_chain(resolve_policy(spec, "allegro")[0], objs, hand="allegro",
                        trials_per_object=rep.trials_per_object(per_sequence), seed=rep.seed, progress=False)
     chains = summarize_chain(trials)
-    by_mode = {m: v for m, v in chain_last_phase_by_mode(trials).items()}
+    by_mode = chain_last_phase_by_mode(trials)
     out["long_horizon"] = dict(summary=chains, in_hand_phase_by_mode=by_mode)
     print(chain_table(chains), "\nIn-hand phase by mode:", "; ".join(f"{m} {sr_cell(v)}" for m, v in by_mode.items()),
           flush=True)
