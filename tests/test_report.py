@@ -24,6 +24,13 @@ def test_report_paper_one_trial(tmp_path):
                              trials_per_object=1, seed=0, progress=False)
         experts_part = lh.split("experts:allegro", 1)[1]
         assert E.chain_table(E.summarize_chain(trials)) in experts_part
+        # the report keeps the summaries of its long horizons (seed_cells.py reads them)
+        from unicross.report import PaperReport
+        rep = PaperReport(hand="allegro", limit=1, trials=1, min_trials=0)
+        lines = rep.chain("experts", E.make_experts_policy("allegro", "allegro")[0])
+        kept = rep.chain_summaries["experts"]
+        assert lines[0] == E.chain_table(kept["summary"]) == E.chain_table(E.summarize_chain(trials))
+        assert kept["in_hand_phase_by_mode"] == E.chain_last_phase_by_mode(trials)
     n_test = len(get_object_set("test", limit=1))
     ships = shipped("allegro")
     for mode in ("grasp", "relocate"):

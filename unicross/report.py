@@ -165,6 +165,7 @@ class PaperReport:
         from unicross.gaits import shipped_gaits
         self.gaits = shipped_gaits(hand)
         self.summaries: Dict[tuple, dict] = {}  # (mode, spec, objects, disturb) -> the cell's summary
+        self.chain_summaries: Dict[str, dict] = {}  # name -> its long horizon's summary and in-hand phase by mode
         self.student_modes = list(F.MODES)
         if "student" in self.ckpts:  # a student distilled from some experts only is evaluated on those
             import torch
@@ -341,7 +342,7 @@ class PaperReport:
         missing = [m for m in F.MODES if m not in self.student_modes]
         note = ([f"The student was distilled for {', '.join(self.student_modes)} only (not for "
                  f"{', '.join(missing)}): phases of those modes are not expected to succeed.", ""] if missing else [])
-        lines = note + self._chain(resolve_policy(self.ckpts["student"], self.hand)[0])
+        lines = note + self.chain("student", resolve_policy(self.ckpts["student"], self.hand)[0])
         lines += [f"The experts, each phase acted on by its mode's shipped expert (`unicross chain --policy "
                   f"experts:{self.hand}`), on the same trials: what the student's teachers do chained.", ""]
         no_expert = [m for m in F.MODES if m not in self.ckpts]
@@ -349,20 +350,23 @@ class PaperReport:
             lines += [f"Not run: no shipped expert for {', '.join(no_expert)}.", ""]
         else:
             self.log("long horizon, the experts ...")
-            lines += self._chain(make_experts_policy(self.hand, self.hand, self.seed)[0])
+            lines += self.chain("experts", make_experts_policy(self.hand, self.hand, self.seed)[0])
         return lines + ["Paper (its student): " + "; ".join(f"{k} {' / '.join(f'{x:g}' for x in v)}"
                                                             for k, v in PAPER["long"].items()), ""]
 
-    def _chain(self, policy) -> List[str]:
-        """The paper's long-horizon protocol with ``policy``: per-phase table and the in-hand phase by mode."""
+    def chain(self, name: str, policy) -> List[str]:
+        """The paper's long-horizon protocol with ``policy``: per-phase table and the in-hand phase by mode
+        (the summaries kept in ``chain_summaries[name]``)."""
         from unicross.evaluation import chain_last_phase_by_mode, chain_table, run_chain, summarize_chain, sr_cell
         objs = get_object_set("test", limit=self.limit)
         # the paper's sequences split the objects: wrappable ones rotate, elongated ones translate
         per_sequence = min(sum(o.category == c for o in objs) for c in {o.category for o in objs})
         trials = run_chain(policy, objs, hand=self.hand, trials_per_object=self.trials_per_object(per_sequence),
                            seed=self.seed, progress=False)
-        by_mode = "; ".join(f"{m} {sr_cell(v)}" for m, v in chain_last_phase_by_mode(trials).items())
-        return [chain_table(summarize_chain(trials)), "", f"In-hand phase by mode: {by_mode}.", ""]
+        chains, by_mode = summarize_chain(trials), chain_last_phase_by_mode(trials)
+        self.chain_summaries[name] = dict(summary=chains, in_hand_phase_by_mode=by_mode)
+        by_mode_text = "; ".join(f"{m} {sr_cell(v)}" for m, v in by_mode.items())
+        return [chain_table(chains), "", f"In-hand phase by mode: {by_mode_text}.", ""]
 
 
 def paper_report(out: str, argv: List[str], **kwargs) -> str:

@@ -11,9 +11,7 @@ import json
 import sys
 
 from unicross import formulation as F
-from unicross.evaluation import (chain_last_phase_by_mode, chain_table, resolve_policy, run_chain, sr_cell,
-                                 summarize_chain)
-from unicross.objects import get_object_set
+from unicross.evaluation import resolve_policy
 from unicross.report import PaperReport
 
 if __name__ == "__main__":
@@ -22,20 +20,11 @@ if __name__ == "__main__":
     out = {"checkpoint": spec, "test": {}}
     for mode in F.MODES:
         cell = rep.evaluate(mode, spec, "test")
-        s = rep.summaries[(mode, spec, "test", False)]
-        out["test"][mode] = dict(cell=cell, summary=s)
+        out["test"][mode] = dict(cell=cell, summary=rep.summaries[(mode, spec, "test", False)])
         print(mode, cell, flush=True)
-    # the long horizon exactly as PaperReport._chain runs it, keeping the summaries
-    objs = get_object_set("test", limit=rep.limit)
-    per_sequence = min(sum(o.category == c for o in objs) for c in {o.category for o in objs})
-    trials = run_chain(resolve_policy(spec, "allegro")[0], objs, hand="allegro",
-                       trials_per_object=rep.trials_per_object(per_sequence), seed=rep.seed, progress=False)
-    chains = summarize_chain(trials)
-    by_mode = chain_last_phase_by_mode(trials)
-    out["long_horizon"] = dict(summary=chains, in_hand_phase_by_mode=by_mode)
-    print(chain_table(chains), "\nIn-hand phase by mode:", "; ".join(f"{m} {sr_cell(v)}" for m, v in by_mode.items()),
-          flush=True)
+    print("\n".join(rep.chain("student", resolve_policy(spec, "allegro")[0])), flush=True)
+    out["long_horizon"] = rep.chain_summaries["student"]
     out["test_successes"] = sum(c["summary"]["successes"] for c in out["test"].values())
-    out["long_horizon_successes"] = sum(c["overall"]["successes"] for c in chains.values())
+    out["long_horizon_successes"] = sum(c["overall"]["successes"] for c in out["long_horizon"]["summary"].values())
     json.dump(out, open(out_path, "w"), indent=1, default=float)
     print(json.dumps({k: out[k] for k in ("test_successes", "long_horizon_successes")}))
