@@ -61,7 +61,8 @@ class EpisodeStarts:
     def _in_hand_start(self, env_idx, hand_p, hand_q, obj_p, obj_q, fq):
         """In-hand start (envs whose skill does not start on the table keep the given start): a grasp
         state from the dataset, with the wrist where it was grasped (``Skill.wrist_where_grasped``,
-        relocate) or at ``in_hand_start_height`` in a random (or palm-up) orientation (rotate, translate).
+        relocate, and rows marked ``keep_wrist``: states recorded where a chain left the hand) or at
+        ``in_hand_start_height`` in a random (or palm-up) orientation (rotate, translate).
         Returns hand and object poses, finger positions and targets, and the recorded coupled-joint
         positions (``(is_grasp, mimic_qpos)`` or None)."""
         dev, g, b = self.device, self._gen, len(env_idx)
@@ -73,10 +74,12 @@ class EpisodeStarts:
             xu = torch.tensor([0.0, 0.0, 1.0], device=dev).expand(b, 3)
             zu = torch.stack([torch.cos(psi), torch.sin(psi), torch.zeros_like(psi)], -1)
             random_q = quat_from_matrix(torch.stack([xu, torch.cross(zu, xu, dim=-1), zu], dim=-1))
-        is_reloc = self._wrist_where_grasped[self.mode[env_idx]][:, None]
-        world_q = torch.where(is_reloc, gs["wrist_pose"][:, 3:], random_q)
+        keep = self._wrist_where_grasped[self.mode[env_idx]][:, None]
+        if "keep_wrist" in gs.keys():  # rows recorded where a chain left the hand start there
+            keep = keep | gs["keep_wrist"][:, None]
+        world_q = torch.where(keep, gs["wrist_pose"][:, 3:], random_q)
         inhand_p = torch.tensor([0.0, 0.0, self.cfg["in_hand_start_height"]], device=dev).expand(b, 3)
-        world_p = torch.where(is_reloc, gs["wrist_pose"][:, :3], inhand_p)
+        world_p = torch.where(keep, gs["wrist_pose"][:, :3], inhand_p)
         op, oq = pose_mul(world_p, world_q, gs["object_pose_hand"][:, :3], gs["object_pose_hand"][:, 3:])
         is_grasp = self._starts_on_table[self.mode[env_idx]][:, None]
         mq = None

@@ -76,3 +76,40 @@ def test_every_contact_link_belongs_to_its_finger_or_the_palm(hand):
     assert set(fingers) == set(u.hand_spec.fingers) | {"palm"}
     if hand == "allegro":  # configs/hands/allegro.yaml: base_link, then 5 links per finger in joint order
         assert fingers == ["palm"] + ["index"] * 5 + ["middle"] * 5 + ["ring"] * 5 + ["thumb"] * 5
+
+
+def test_chained_grasps_start_in_hand_where_the_chain_left_the_hand():
+    """`unicross grasps --chain grasp,relocate` keeps the states where the shipped experts' chain left
+    the hand, marked keep_wrist; merged with the grasp expert's rows (which get keep_wrist False), a
+    translate start from such a row puts the hand at the recorded wrist pose and the object where it
+    was in the hand, while a start from a grasp-expert row of the same object goes to the start height."""
+    import gymnasium as gym
+    from unicross.registry import SKILLS
+    from unicross.rl.expert_grasps import chained_grasps
+    obj = get_object_set("train-elongated", limit=1)[:1]
+    chained, stats = chained_grasps("experts:allegro", "allegro", obj, "grasp,relocate", per_object=1, seed=1,
+                                    progress=False)
+    assert len(chained) == 1 and stats["kept"][obj[0].name] == 1, stats
+    assert chained.data["keep_wrist"].all() and chained.source == "chain:grasp,relocate:experts:allegro"
+    shipped = GraspSet.load(default_grasp_path("allegro"))
+    own = shipped.data[shipped.data["object_id"] == shipped.object_names.index(obj[0].name)][:1]
+    own["object_id"] = torch.zeros_like(own["object_id"])
+    expert_row = GraspSet("allegro", [obj[0].name], own, shipped.source)
+    merged = GraspSet.merge([expert_row, chained])
+    assert merged.data["keep_wrist"].tolist() == [False, True] and "+" in merged.source
+    skill = SKILLS["translate"]
+    env = gym.make(skill.env_id, obs_mode="none", sim_backend="physx_cpu", render_backend="none", hand="allegro",
+                   objects=obj, randomize=False, grasp_dataset=merged, **skill.env_kwargs("z+"))
+    u = env.unwrapped
+    height = u.cfg["in_hand_start_height"]
+    for row in (0, 1):
+        u.grasps = GraspSet("allegro", [obj[0].name], merged.data[row:row + 1], merged.source)
+        u.reset(seed=row)
+        pos, _ = u.sensor.poses()
+        rec = merged.data["wrist_pose"][row]
+        if row:
+            assert torch.allclose(pos[0, 0], rec[:3], atol=1e-4), (pos[0, 0], rec)
+            assert torch.allclose(u.cur_rel.x_oh[0], merged.data["object_pose_hand"][row, :3], atol=1e-4)
+        else:
+            assert torch.allclose(pos[0, 0], torch.tensor([0.0, 0.0, height]), atol=1e-4), pos[0, 0]
+    env.close()

@@ -66,7 +66,14 @@ def _cmd_grasps(args) -> int:
     objs = get_object_set(args.objects, limit=args.limit)
     out = Path(args.out)
     t0 = time.time()
-    if args.expert:
+    if args.chain:
+        from unicross.rl.expert_grasps import chained_grasps
+        if args.expert:
+            raise ValueError("--chain and --expert exclude each other (--policy runs the chain's every phase)")
+        if not args.policy:
+            raise ValueError("--chain needs --policy (e.g. experts:allegro): the policy that runs the chain")
+        gs, stats = chained_grasps(args.policy, args.hand, objs, args.chain, args.per_object, seed=args.seed)
+    elif args.expert:
         from unicross.rl.expert_grasps import expert_grasps
         from unicross.rl.policy_io import load_policy
         _, ck = load_policy(args.expert)  # fails fast on a missing/invalid checkpoint
@@ -89,7 +96,7 @@ def _cmd_grasps(args) -> int:
                    hold_2s_rate=round(sum(held) / len(held), 4) if held else None,
                    kept=("all" if args.keep_all or not held else "holding"),
                    fingers_after_hold=census, per_object=gs.counts(), seconds=round(took, 1))
-    print(f"{'expert' if args.expert else 'scripted'} success {stats['success_rate']:.1%}, {found} grasps"
+    print(f"{'chain' if args.chain else 'expert' if args.expert else 'scripted'} success {stats['success_rate']:.1%}, {found} grasps"
           + (f"; restored grasps holding for 2 s: {sum(held)}/{len(held)} = {sum(held) / len(held):.1%}" if held else "")
           + f"; wrote {len(gs)} grasps ({summary['kept']}) of {len(objs)} objects to {out} in {took:.0f}s")
     for cat, c in (census or {}).items():
@@ -512,6 +519,11 @@ def main(argv=None) -> int:
     s.set_defaults(fn=_cmd_hands)
     s = sub.add_parser("grasps", help="build a grasp-state dataset (grasp expert, or the scripted synthesiser)")
     s.add_argument("--expert", default=None, help="grasp expert checkpoint (default: the scripted synthesiser)")
+    s.add_argument("--chain", default=None,
+                   help="record the states where a chain SEQUENCE (e.g. grasp,relocate) run by --policy leaves the "
+                        "hand instead (rows marked keep_wrist: in-hand starts from them keep that wrist pose); with "
+                        "--append, chain-aware starts for an in-hand mode's training")
+    s.add_argument("--policy", default=None, help="with --chain: the policy that runs it (experts:allegro, a student, ...)")
     s.add_argument("--objects", default="train", help="object set (train, test-wrappable, unseen, mesh:<file>, ...)")
     s.add_argument("--limit", type=positive, default=None, help="first N objects of each (category, type) group")
     s.add_argument("--per-object", type=positive, default=5)

@@ -12,6 +12,10 @@ One file (``torch.save``) holds::
         object_id          [B]     index into object_names
         mimic_qpos         [B, M]  (optional) coupled joints' positions, the hand's ``mimic`` order;
                                    without it a restore puts them where the coupling says
+        keep_wrist         [B]     (optional, bool) an in-hand start from this row keeps ``wrist_pose``
+                                   (rows recorded where a chain left the hand, ``unicross grasps
+                                   --chain``); without it, or False: the start height and a random
+                                   orientation for rotate / translate, the recorded pose for relocate
     }
 
 The scripted synthesiser (:mod:`unicross.scripted_grasp`) and, later, the grasp expert write this
@@ -32,7 +36,8 @@ FORMAT = "unicross-grasps/1"
 KEYS = ("finger_qpos", "finger_target", "wrist_pose", "object_pose_hand", "object_id")
 
 
-OPTIONAL_KEYS = ("mimic_qpos",)
+OPTIONAL_KEYS = ("mimic_qpos", "keep_wrist")
+FILL = {"keep_wrist": False}  # optional keys a merge fills where a part lacks them (the others it drops)
 
 
 def empty_rows() -> Dict[str, list]:
@@ -111,9 +116,15 @@ class GraspSet:
             d = s.data.clone()
             d["object_id"] = torch.tensor(remap)[d["object_id"]]
             parts.append(d)
-        common = set.intersection(*(set(p.keys()) for p in parts))  # optional keys only where all have them
+        for k in FILL:  # e.g. grasps from the grasp expert merged with rows recorded after a chain
+            if any(k in p.keys() for p in parts):
+                for p in parts:
+                    if k not in p.keys():
+                        p[k] = torch.full(p.batch_size, FILL[k])
+        common = set.intersection(*(set(p.keys()) for p in parts))  # other optional keys only where all have them
         parts = [p.select(*sorted(common)) for p in parts]
-        return GraspSet(sets[0].hand, names, torch.cat(parts), sets[0].source)
+        sources = list(dict.fromkeys(s.source for s in sets))  # each once, in order
+        return GraspSet(sets[0].hand, names, torch.cat(parts), "+".join(sources))
 
     def sample(self, env_object: torch.Tensor, env_object_names: Sequence[str],
                generator: Optional[torch.Generator] = None, needed: Optional[torch.Tensor] = None) -> TensorDict:
