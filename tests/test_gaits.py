@@ -249,6 +249,44 @@ def test_the_guard_pauses_the_gait_and_tightens_while_too_few_links_touch(tmp_pa
         make_gait_policy(str(tmp_path / "log.jsonl"), guard=-1)
 
 
+def test_the_drift_guard_tightens_while_the_object_is_off_its_place_then_lets_the_gait_go_on(tmp_path):
+    """``drift=D``: while the object is more than D from its target position in the hand, the clock gait stands
+    still and the fingers close by GUARD_RATE a step; once the tightening has reached guard_max the gait goes on
+    around the tightened grasp although the object stays off its place (a drift persists). Close to its place it
+    is the plain gait."""
+    from unicross.gaits import GUARD_RATE, gait_offsets
+    from robots.hand import load_hand
+    from unicross.scripted_grasp import closing_direction
+    g = torch.Generator().manual_seed(3)
+    _write(tmp_path / "log.jsonl", [dict(meta=dict(amplitude=1.0), p=(torch.rand(NPAR, generator=g) * 2 - 1).tolist(),
+                                         score=1.0)])
+    p = best_gait(str(tmp_path / "log.jsonl"))[0]
+    guarded = make_gait_policy(str(tmp_path / "log.jsonl"), drift=0.02, guard_max=0.05)
+    plain = make_gait_policy(str(tmp_path / "log.jsonl"))
+    u, v = _stand_in_env(1, "rotate_y-", [0.0, -1.0, 0.0]), _stand_in_env(1, "rotate_y-", [0.0, -1.0, 0.0])
+    u.hand_spec = v.hand_spec = load_hand("allegro")
+    u.action_scale = v.action_scale = torch.full((22,), 10.0)  # no clamp
+    u._obs_parts = dict(contact=torch.ones(1, 16))  # every link touches: only the drift can trigger
+    u.cur_rel, u.targets = SimpleNamespace(x_oh=torch.zeros(1, 3)), SimpleNamespace(x_oh=torch.zeros(1, 3))
+    closing = closing_direction(u.hand_spec)
+    for t in range(3):
+        u.elapsed_steps[:] = v.elapsed_steps[:] = t
+        a, b = guarded(None, u), plain(None, v)
+        torch.testing.assert_close(a, b)
+        u.command[:, 6:] += a[:, 6:] * 10.0
+        v.command[:, 6:] += b[:, 6:] * 10.0
+    u.cur_rel.x_oh[0, 0] = 0.03  # 3 cm off its place: the gait pauses at its clock 3 and closes, up to guard_max
+    for t, tight in ((3, GUARD_RATE), (4, 2 * GUARD_RATE), (5, 0.05)):
+        u.elapsed_steps[:] = t
+        u.command[:, 6:] += guarded(None, u)[:, 6:] * 10.0
+        torch.testing.assert_close(u.command[0, 6:], gait_offsets(p, torch.tensor(3.0)) + tight * closing, atol=1e-5, rtol=0)
+    u.elapsed_steps[:] = 6  # still off its place, fully tightened: the gait goes on from its clock 4
+    u.command[:, 6:] += guarded(None, u)[:, 6:] * 10.0
+    torch.testing.assert_close(u.command[0, 6:], gait_offsets(p, torch.tensor(4.0)) + 0.05 * closing, atol=1e-5, rtol=0)
+    with pytest.raises(ValueError, match="drift"):
+        make_gait_policy("allegro/rotate_y-,drift=-0.01")
+
+
 def test_a_gait_layout_follows_the_hand_and_keeps_allegros_gaits():
     """Allegro's layout read from its description is the built-in one (its shipped gaits move the same joints);
     Sharpa Wave's five fingers give 31 numbers that move only its named gait joints, flexing along the

@@ -158,12 +158,12 @@ SHIPPED_DIR = Path(__file__).resolve().parent / "checkpoints"
 
 
 GAIT_OPTIONS = {"tracking": str, "lookahead": float, "grid": int, "reverse": int, "guard": int, "guard_max": float,
-                "stop": int}
+                "stop": int, "drift": float}
 
 
 def split_gait_spec(spec: str) -> Tuple[str, dict]:
     """(gait, options) of ``GAIT[,key=value...]``, the options of :func:`make_gait_policy`
-    (``tracking``, ``lookahead``, ``grid``, ``reverse``, ``guard``, ``guard_max``, ``stop``), e.g. ``allegro/rotate_y-,tracking=phase,lookahead=1.5``
+    (``tracking``, ``lookahead``, ``grid``, ``reverse``, ``guard``, ``guard_max``, ``stop``, ``drift``), e.g. ``allegro/rotate_y-,tracking=phase,lookahead=1.5``
     or ``allegro/rotate_y-,reverse=1`` (the y- gait run backwards, :func:`reverse_gait`)."""
     base, *rest = spec.split(",")
     opts = {}
@@ -242,7 +242,7 @@ GUARD_RATE = 0.02  # rad a control step along the closing direction while a guar
 
 
 def make_gait_policy(spec: str, tracking: str = "clock", lookahead: float = 1.0, grid: int = 8, reverse: int = 0,
-                     guard: int = 0, guard_max: float = 0.15, stop: int = 1):
+                     guard: int = 0, guard_max: float = 0.15, stop: int = 1, drift: float = 0.0):
     """The scripted in-hand policy of the best gait in ``spec`` (a log, or a shipped gait's
     ``<hand>/<mode>``; see the module docstring). Options written into ``spec`` after commas
     (``allegro/rotate_y-,tracking=phase,lookahead=1.5``; :func:`split_gait_spec`) override the
@@ -268,6 +268,12 @@ def make_gait_policy(spec: str, tracking: str = "clock", lookahead: float = 1.0,
     ``GUARD_RATE`` a step, up to ``guard_max`` rad in all; the gait then goes on around the tightened
     grasp (the tightening stays).
 
+    ``drift=D`` (metres, 0: off): the same reaction, also while the object is more than D from its target
+    position in the hand (the rotate formulation fixes it at the start position; both are in the observation's
+    goal) and the grasp has not yet tightened by ``guard_max``, so a grasp the gait is loosening tightens before
+    the object has slid out. Measured once on the y- gait without the stop (2026-12-03, training objects, n = 120;
+    `docs/record/rotation_gaits.md`): no gain.
+
     ``stop=0``: the gait never stops (no privileged read of the object's motion): it keeps cycling for
     the whole episode, as the paper's policies keep turning. Its action is then a function of the
     command and q0 alone (with ``tracking=phase``), with no unobservable switch to standing still,
@@ -278,11 +284,12 @@ def make_gait_policy(spec: str, tracking: str = "clock", lookahead: float = 1.0,
     tracking, lookahead, grid = opts.get("tracking", tracking), opts.get("lookahead", lookahead), opts.get("grid", grid)
     reverse = opts.get("reverse", reverse)
     guard, guard_max = opts.get("guard", guard), opts.get("guard_max", guard_max)
-    stop = opts.get("stop", stop)
+    stop, drift = opts.get("stop", stop), opts.get("drift", drift)
     if stop not in (0, 1):
         raise ValueError(f"gait stop must be 0 or 1, got {stop}")
-    if guard < 0 or guard_max < 0:
-        raise ValueError(f"gait guard and guard_max must be >= 0, got {guard} and {guard_max}")
+    if guard < 0 or guard_max < 0 or drift < 0:
+        raise ValueError(f"gait guard, guard_max and drift must be >= 0, got {guard}, {guard_max} and {drift}")
+    guarded = guard > 0 or drift > 0
     if tracking not in TRACKING:
         raise ValueError(f"gait tracking must be one of {TRACKING}, got {tracking!r}")
     if grid < 1:
@@ -318,7 +325,7 @@ def make_gait_policy(spec: str, tracking: str = "clock", lookahead: float = 1.0,
                          threshold=torch.where(is_rot, sc["rotate_angle"], sc["translate_dist"]),
                          motion=torch.zeros(u.num_envs, device=u.device),
                          done=torch.zeros(u.num_envs, dtype=torch.bool, device=u.device))
-            if guard > 0:  # the guard's own clock, its tightening so far, and the direction it tightens
+            if guarded:  # the guard's own clock, its tightening so far, and the direction it tightens
                 from unicross.scripted_grasp import closing_direction
                 state.update(clock=torch.zeros(u.num_envs, device=u.device),
                              tight=torch.zeros(u.num_envs, 1, device=u.device),
@@ -330,19 +337,23 @@ def make_gait_policy(spec: str, tracking: str = "clock", lookahead: float = 1.0,
             state["done"] |= state["motion"] > state["threshold"]
         a = torch.zeros(u.num_envs, u.hand_spec.dof, device=u.device)
         centre = state["q0"]  # the gait's centre: the start command, tightened by the guard
-        if guard > 0:
+        if guarded:
             slipping = (observed_contact(u) > 0).sum(-1) < guard  # the observation's contact flags
+            if drift > 0:  # the object's distance from its target position in the hand (the goal's fixed slot);
+                # a drift persists, so it pauses the gait only while the grasp can still tighten
+                drifting = torch.linalg.norm(u.cur_rel.x_oh - u.targets.x_oh, dim=-1) > drift
+                slipping = slipping | (drifting & (state["tight"][:, 0] < guard_max))
             state["tight"] = torch.where(slipping[:, None], (state["tight"] + GUARD_RATE).clamp(max=guard_max),
                                          state["tight"])
             centre = centre + state["tight"] * state["closing"]
         if tracking == "clock":
-            if guard > 0:  # the gait's own clock, which stands still while the guard tightens
+            if guarded:  # the gait's own clock, which stands still while the guard tightens
                 state["clock"] += (~slipping).float()
                 target = centre + gait_offsets(p, state["clock"].double(), layout=layout).to(u.device)
             else:
                 target = gait_targets(p, t + 1, state["q0"], layout)
         else:
-            ahead = torch.where(slipping, 0.0, lookahead) if guard > 0 else lookahead
+            ahead = torch.where(slipping, 0.0, lookahead) if guarded else lookahead
             target = centre + phase_offsets(p, taus.to(u.device), cycle.to(u.device), u.command[:, 6:] - centre,
                                             ahead, layout)
         step = ((target - u.command[:, 6:]) / u.action_scale[6:]).clamp(-1, 1)
