@@ -210,32 +210,43 @@ def test_a_reversed_gait_runs_the_same_loop_backwards_and_is_a_gait_for_the_oppo
         make_gait_policy("allegro/rotate_y-,reverse=2")
 
 
-def test_the_guard_pauses_the_gait_and_tightens_while_too_few_links_touch(tmp_path):
-    """``guard=K``: with fewer than K links in contact the clock gait stands still and the fingers close
-    along the closing direction by GUARD_RATE a step (at most guard_max); with enough contact it is
-    the plain gait, its clock counting only the steps it ran."""
-    from unicross.gaits import GUARD_RATE, gait_offsets
+def _guarded_and_plain(tmp_path, seed: int, **guard):
+    """(gait p, the gait with ``guard`` options, the plain gait, two stand-in y- envs of Allegro with unclamped
+    actions for them, the closing direction): what the guard tests step side by side."""
     from robots.hand import load_hand
     from unicross.scripted_grasp import closing_direction
-    g = torch.Generator().manual_seed(2)
+    g = torch.Generator().manual_seed(seed)
     _write(tmp_path / "log.jsonl", [dict(meta=dict(amplitude=1.0), p=(torch.rand(NPAR, generator=g) * 2 - 1).tolist(),
                                          score=1.0)])
     p = best_gait(str(tmp_path / "log.jsonl"))[0]
-    guarded = make_gait_policy(str(tmp_path / "log.jsonl"), guard=2, guard_max=0.05)
+    guarded = make_gait_policy(str(tmp_path / "log.jsonl"), **guard)
     plain = make_gait_policy(str(tmp_path / "log.jsonl"))
     u, v = _stand_in_env(1, "rotate_y-", [0.0, -1.0, 0.0]), _stand_in_env(1, "rotate_y-", [0.0, -1.0, 0.0])
     u.hand_spec = v.hand_spec = load_hand("allegro")
     u.action_scale = v.action_scale = torch.full((22,), 10.0)  # no clamp
-    closing = closing_direction(u.hand_spec)
-    contact = torch.zeros(1, 16)
-    u._obs_parts = dict(contact=contact)
-    contact[0, :3] = 1.0  # three links touch: the plain gait
-    for t in range(3):
+    return p, guarded, plain, u, v, closing_direction(u.hand_spec)
+
+
+def _same_for(steps: int, guarded, plain, u, v) -> None:
+    """Steps the guarded gait on ``u`` and the plain one on ``v`` from step 0, checking that they act alike."""
+    for t in range(steps):
         u.elapsed_steps[:] = v.elapsed_steps[:] = t
         a, b = guarded(None, u), plain(None, v)
         torch.testing.assert_close(a, b)
         u.command[:, 6:] += a[:, 6:] * 10.0
         v.command[:, 6:] += b[:, 6:] * 10.0
+
+
+def test_the_guard_pauses_the_gait_and_tightens_while_too_few_links_touch(tmp_path):
+    """``guard=K``: with fewer than K links in contact the clock gait stands still and the fingers close
+    along the closing direction by GUARD_RATE a step (at most guard_max); with enough contact it is
+    the plain gait, its clock counting only the steps it ran."""
+    from unicross.gaits import GUARD_RATE, gait_offsets
+    p, guarded, plain, u, v, closing = _guarded_and_plain(tmp_path, 2, guard=2, guard_max=0.05)
+    contact = torch.zeros(1, 16)
+    u._obs_parts = dict(contact=contact)
+    contact[0, :3] = 1.0  # three links touch: the plain gait
+    _same_for(3, guarded, plain, u, v)
     contact[0, 1:] = 0.0  # one link: the gait pauses at its clock 3 and closes the grasp, up to guard_max
     for t, tight in ((3, GUARD_RATE), (4, 2 * GUARD_RATE), (5, 0.05), (6, 0.05)):
         u.elapsed_steps[:] = t
@@ -255,26 +266,10 @@ def test_the_drift_guard_tightens_while_the_object_is_off_its_place_then_lets_th
     around the tightened grasp although the object stays off its place (a drift persists). Close to its place it
     is the plain gait."""
     from unicross.gaits import GUARD_RATE, gait_offsets
-    from robots.hand import load_hand
-    from unicross.scripted_grasp import closing_direction
-    g = torch.Generator().manual_seed(3)
-    _write(tmp_path / "log.jsonl", [dict(meta=dict(amplitude=1.0), p=(torch.rand(NPAR, generator=g) * 2 - 1).tolist(),
-                                         score=1.0)])
-    p = best_gait(str(tmp_path / "log.jsonl"))[0]
-    guarded = make_gait_policy(str(tmp_path / "log.jsonl"), drift=0.02, guard_max=0.05)
-    plain = make_gait_policy(str(tmp_path / "log.jsonl"))
-    u, v = _stand_in_env(1, "rotate_y-", [0.0, -1.0, 0.0]), _stand_in_env(1, "rotate_y-", [0.0, -1.0, 0.0])
-    u.hand_spec = v.hand_spec = load_hand("allegro")
-    u.action_scale = v.action_scale = torch.full((22,), 10.0)  # no clamp
+    p, guarded, plain, u, v, closing = _guarded_and_plain(tmp_path, 3, drift=0.02, guard_max=0.05)
     u._obs_parts = dict(contact=torch.ones(1, 16))  # every link touches: only the drift can trigger
     u.cur_rel, u.targets = SimpleNamespace(x_oh=torch.zeros(1, 3)), SimpleNamespace(x_oh=torch.zeros(1, 3))
-    closing = closing_direction(u.hand_spec)
-    for t in range(3):
-        u.elapsed_steps[:] = v.elapsed_steps[:] = t
-        a, b = guarded(None, u), plain(None, v)
-        torch.testing.assert_close(a, b)
-        u.command[:, 6:] += a[:, 6:] * 10.0
-        v.command[:, 6:] += b[:, 6:] * 10.0
+    _same_for(3, guarded, plain, u, v)
     u.cur_rel.x_oh[0, 0] = 0.03  # 3 cm off its place: the gait pauses at its clock 3 and closes, up to guard_max
     for t, tight in ((3, GUARD_RATE), (4, 2 * GUARD_RATE), (5, 0.05)):
         u.elapsed_steps[:] = t
