@@ -47,7 +47,8 @@ from unicross import formulation as F
 
 def _rollouts(gait: str, hand: str, objects: str, limit: int, trials: int, seed: int, randomize: bool,
               student, shard, beta: float = 0.0, privileged_q0: bool = False, clock: bool = False,
-              history: int = 0, sequence: str = None, mode: str = None, grasps: str = None) -> tuple:
+              history: int = 0, sequence: str = None, mode: str = None, grasps: str = None,
+              accumulated: bool = False) -> tuple:
     """One worker's share: (obs dict of [N, d], labels [N, A], trials) of the protocol of the gait's mode
     on its objects, the gait acting (``student`` None) or the student's mean acting while the gait labels
     (with ``sequence``, a finger sequence of :mod:`unicross.sequences` on ``mode``'s protocol instead);
@@ -93,6 +94,10 @@ def _rollouts(gait: str, hand: str, objects: str, limit: int, trials: int, seed:
         if clock:  # diagnosis only: the gait's clock (its phase at this step) appended to the hand state
             th = 2 * torch.pi * u.elapsed_steps.float()[:, None] / period
             parts = (torch.cat([parts[0], torch.sin(th), torch.cos(th)], -1),) + tuple(parts[1:])
+        if accumulated:  # diagnosis only: the motion accumulated along the axis so far, over the success threshold
+            sc = u.cfg["success"]
+            done = u.rot_acc / sc["rotate_angle"] if skill == "rotate" else u.trans_acc / sc["translate_dist"]
+            parts = (torch.cat([parts[0], done[:, None]], -1),) + tuple(parts[1:])
         for k, x in zip(keys, parts):
             rows[k].append(x.clone())
         labels.append(label.clone())
@@ -142,6 +147,10 @@ def main(argv=None) -> int:
     ap.add_argument("--history", type=int, nargs="?", const=1, default=0, metavar="N",
                     help="diagnosis only: the network also sees the previous N control steps' s^h (joint readings "
                          "and command; N = 1 without a number), as HORA's proprioceptive history (30 steps there); "
+                         "its checkpoint does not fit the UniCross observation and is not written")
+    ap.add_argument("--progress", action="store_true",
+                    help="diagnosis only: the network also sees the motion accumulated along the axis so far over the "
+                         "success threshold (what a gait's stop reads; a memory of the episode the observation lacks); "
                          "its checkpoint does not fit the UniCross observation and is not written")
     ap.add_argument("--randomize", action="store_true", help="training's randomisation (default: the evaluation's conditions)")
     ap.add_argument("--grasps", default=None, help="grasp-state dataset the episodes start from (default: the shipped one)")
@@ -203,7 +212,8 @@ def main(argv=None) -> int:
         with ProcessPoolExecutor(args.workers, mp_context=ctx) as ex:
             return [f.result() for f in [ex.submit(_rollouts, args.gait, args.hand, objects, limit, trials, seed,
                                                     randomize, student, (i, args.workers), beta, args.privileged_q0,
-                                                    args.clock, args.history, args.sequence, mode, args.grasps)
+                                                    args.clock, args.history, args.sequence, mode, args.grasps,
+                                                    args.progress)
                                           for i in range(args.workers)]]
 
     for r in range(args.rounds + 1):
@@ -275,7 +285,7 @@ def main(argv=None) -> int:
               git_commit=git_commit(), commits=[git_commit()],
               clone_of=args.gait or f"seq:{args.sequence}",
               wall_s=round(time.time() - t0, 1))
-    diagnosis = args.privileged_q0 or args.clock or args.history
+    diagnosis = args.privileged_q0 or args.clock or args.history or args.progress
     if not diagnosis:
         torch.save(ck, out / "policy.pt")
     with open(out / "log.jsonl", "w") as f:
