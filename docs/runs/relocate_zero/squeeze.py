@@ -2,9 +2,9 @@
 
 The zero action beats the shipped relocate expert on the paper's full test protocol, disturbed and not
 (docs/record/full_protocol.md, last section); most of the zero action's failures are drops. This runs the policy
-"wrist residual zero, fingers driven to the grasp pose closed by TIGHTEN rad" (``tightened_fingers_action``, the
-finger half of the paper's naive relocation baseline) on every fifth test object (index 0 mod 5 of the full list, so
-every trial is seeded as in the full-protocol runs and pairs with them trial by trial), all 25 trials each:
+"wrist residual zero, fingers closed by TIGHTEN rad": towards the grasp pose (``tightened_fingers_action``, the finger
+half of the paper's naive relocation baseline) or, with ``--relative``, from the finger command held at the first
+step; on every fifth test object (index 0 mod 5 of the full list, so every trial is seeded as in the full-protocol runs and pairs with them trial by trial), all 25 trials each:
 
     python docs/runs/relocate_zero/squeeze.py TIGHTEN OUT.json [--disturb] [--relative]
 
@@ -12,7 +12,6 @@ then pairs OUT.json with the zero action and the expert on the same trials
 (docs/runs/paper_protocol/relocate_full{,_zero}{,_disturb}.json.gz).
 """
 import argparse
-import gzip
 import json
 import multiprocessing as mp
 import sys
@@ -53,9 +52,27 @@ def _shard(tighten, disturb, relative, shard):
                         trials_per_object=25, shard=shard, progress=False)
 
 
-def _trials(path):
-    d = json.load(gzip.open(path) if str(path).endswith(".gz") else open(path))["trials"]
-    return d["relocate"] if isinstance(d, dict) else d
+def report(trials, tighten, relative, disturb):
+    """Prints the run's successes and its paired differences to the zero action and the expert on the same trials."""
+    from unicross.evaluation import read_results
+    key = lambda t: (t["object"], t["trial"])  # noqa: E731
+    mine = {key(t): t for t in trials}
+    suffix = "_disturb" if disturb else ""
+    print(f"tighten {tighten} rad{' from the held command' if relative else ''}{' --disturb' if disturb else ''}: "
+          f"{sum(t['success'] for t in trials)} of {len(trials)} ({sum(t['dropped'] for t in trials)} dropped)")
+    for name in (f"relocate_full_zero{suffix}", f"relocate_full{suffix}"):
+        full = read_results(ROOT / f"docs/runs/paper_protocol/{name}.json.gz")["trials"]["relocate"]
+        other = {key(t): t for t in full if key(t) in mine}
+        assert len(other) == len(mine), name
+        cells = [0, 0, 0, 0]  # both, only this, only the other, neither
+        for k, t in mine.items():
+            s, o = t["success"], other[k]["success"]
+            cells[0 if s and o else 1 if s else 2 if o else 3] += 1
+        lo, hi = newcombe_paired(*cells)
+        n = len(mine)
+        print(f"  against {name}: {100 * (cells[0] + cells[2]) / n:.1f}% there; this - it "
+              f"{100 * (cells[1] - cells[2]) / n:+.1f} points [{100 * lo:+.1f}, {100 * hi:+.1f}], only this {cells[1]}, "
+              f"only it {cells[2]}, p = {mcnemar_exact(cells[1], cells[2]):.2g}")
 
 
 if __name__ == "__main__":
@@ -70,20 +87,4 @@ if __name__ == "__main__":
     trials = [t for part in parts for t in part]
     json.dump(dict(tighten=a.tighten, relative=a.relative, disturb=a.disturb, objects="test, index 0 mod 5", trials=trials),
               open(a.out, "w"), indent=1, default=float)
-    key = lambda t: (t["object"], t["trial"])  # noqa: E731
-    mine = {key(t): t for t in trials}
-    suffix = "_disturb" if a.disturb else ""
-    print(f"tighten {a.tighten} rad{' from the held command' if a.relative else ''}{' --disturb' if a.disturb else ''}: "
-          f"{sum(t['success'] for t in trials)} of {len(trials)} ({sum(t['dropped'] for t in trials)} dropped)")
-    for name in (f"relocate_full_zero{suffix}", f"relocate_full{suffix}"):
-        other = {key(t): t for t in _trials(ROOT / f"docs/runs/paper_protocol/{name}.json.gz") if key(t) in mine}
-        assert len(other) == len(mine), name
-        cells = [0, 0, 0, 0]  # both, only this, only the other, neither
-        for k, t in mine.items():
-            s, o = t["success"], other[k]["success"]
-            cells[0 if s and o else 1 if s else 2 if o else 3] += 1
-        lo, hi = newcombe_paired(*cells)
-        n = len(mine)
-        print(f"  against {name}: {100 * (cells[0] + cells[2]) / n:.1f}% there; this - it "
-              f"{100 * (cells[1] - cells[2]) / n:+.1f} points [{100 * lo:+.1f}, {100 * hi:+.1f}], only this {cells[1]}, "
-              f"only it {cells[2]}, p = {mcnemar_exact(cells[1], cells[2]):.2g}")
+    report(trials, a.tighten, a.relative, a.disturb)
