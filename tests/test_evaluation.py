@@ -60,6 +60,27 @@ def test_scripted_relocation_baseline_table(grasp_file, tiny_objects):
     assert "Relocate SR" in E.markdown_table({"baseline": {"relocate": s}})
 
 
+def test_tightened_fingers_close_from_their_base():
+    """The naive baseline's fingers close from the grasp pose; ``base`` closes from another pose (the held command)."""
+    from types import SimpleNamespace
+
+    from unicross.robots.hand import load_hand
+    from unicross.scripted_grasp import closing_direction
+    spec = load_hand("allegro")
+    nf = spec.dof - 6
+    lo, hi = torch.full((spec.dof,), -3.0), torch.full((spec.dof,), 3.0)
+    u = SimpleNamespace(num_envs=2, hand_spec=spec, device="cpu", finger_q0=torch.zeros(nf), q_lower=lo, q_upper=hi,
+                        command=torch.zeros(2, spec.dof), action_scale=torch.ones(spec.dof))
+    closing = closing_direction(spec)
+    a = E.tightened_fingers_action(u, 0.1)
+    assert torch.allclose(a[:, 6:], (0.1 * closing).expand(2, nf)) and not a[:, :6].any()
+    held = torch.full((2, nf), 0.2)
+    u.command[:, 6:] = held
+    assert torch.allclose(E.tightened_fingers_action(u, 0.0, base=held), torch.zeros(2, spec.dof))
+    assert torch.allclose(E.tightened_fingers_action(u, 0.1, base=held)[:, 6:], (0.1 * closing).expand(2, nf))
+    assert torch.allclose(E.tightened_fingers_action(u, 0.1)[:, 6:], (0.1 * closing - 0.2).expand(2, nf))
+
+
 def test_objects_without_grasps_are_left_out_or_refused(grasp_file, tiny_objects):
     from unicross.grasps import GraspSet
     gs = GraspSet.load(grasp_file)

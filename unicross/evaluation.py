@@ -76,13 +76,14 @@ def make_random_policy(seed: int) -> PolicyFn:
     return policy
 
 
-def tightened_fingers_action(u, tighten: float = 0.1) -> torch.Tensor:
-    """Action [N, dof] that drives the fingers to their grasp pose closed by at most ``tighten``
-    rad along the hand's closing direction (wrist residual zero: the wrist follows its reference)."""
+def tightened_fingers_action(u, tighten: float = 0.1, base: Optional[torch.Tensor] = None) -> torch.Tensor:
+    """Action [N, dof] that drives the fingers to ``base`` (default: their grasp pose ``finger_q0``)
+    closed by at most ``tighten`` rad along the hand's closing direction (wrist residual zero: the
+    wrist follows its reference)."""
     from unicross.scripted_grasp import closing_direction
     a = torch.zeros(u.num_envs, u.hand_spec.dof, device=u.device)
     delta = closing_direction(u.hand_spec).to(u.device) * tighten  # at most `tighten` rad
-    q_des = torch.clamp(u.finger_q0 + delta, u.q_lower[6:], u.q_upper[6:])
+    q_des = torch.clamp((u.finger_q0 if base is None else base) + delta, u.q_lower[6:], u.q_upper[6:])
     a[:, 6:] = (q_des - u.command[:, 6:]) / u.action_scale[6:]
     return a.clamp(-1.0, 1.0)
 
