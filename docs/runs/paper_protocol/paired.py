@@ -21,6 +21,16 @@ def mcnemar_exact(b, c):
     return min(1.0, 2 * tail)
 
 
+def paired_cells(pairs):
+    """(a, b, c, d) of an iterable of (first succeeded, second succeeded): a both, b only the first, c only the
+    second, d neither."""
+    cells = [0, 0, 0, 0]
+    for x, y in pairs:
+        x, y = bool(x), bool(y)
+        cells[0 if x and y else 1 if x else 2 if y else 3] += 1
+    return tuple(cells)
+
+
 def newcombe_paired(a, b, c, d, z=1.96):
     """95% interval of p1 - p2 for paired proportions (Newcombe 1998, method 10): a both succeed, b only
     the first, c only the second, d neither."""
@@ -47,12 +57,8 @@ def main():
     trials = [{tuple(t[k] for k in key): t["success"] for t in r["trials"][skill]} for r in runs]
     if trials[0].keys() != trials[1].keys():
         raise SystemExit("the two evaluations did not run the same trials")
-    s = [[trials[0][k], trials[1][k]] for k in trials[0]]
-    a = sum(x and y for x, y in s)
-    b = sum(x and not y for x, y in s)
-    c = sum(y and not x for x, y in s)
-    d = len(s) - a - b - c
-    n = len(s)
+    a, b, c, d = paired_cells((trials[0][k], trials[1][k]) for k in trials[0])
+    n = a + b + c + d
     for r, k in zip(runs, (a + b, a + c)):
         lo, hi = wilson(k, n)
         print(f"{r['label']:40s} {100 * k / n:5.1f}% [{100 * lo:.1f}-{100 * hi:.1f}] ({k} of {n})")

@@ -12,16 +12,13 @@ import sys
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
-import torch
-
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "relocate_zero"))
-from fifth import SHARDS  # noqa: E402
+from fifth import SHARDS, run_shard  # noqa: E402
 
 
 def _shard(shard):
-    torch.set_num_threads(1)
-    from unicross.evaluation import run_protocol, zero_policy
-    from unicross.objects import get_object_set
+    """The zero action's disturbed trials of one shard, each with its force."""
+    from unicross.evaluation import zero_policy
     forces = []
 
     def policy(obs, u):
@@ -30,8 +27,7 @@ def _shard(shard):
             mg = float(u.obj_mass[0]) * u._gravity
             forces.append(dict(scale=float(f.norm()) / mg, cos_down=float(-f[2] / f.norm().clamp_min(1e-9))))
         return zero_policy(obs, u)
-    trials = run_protocol("relocate", policy, get_object_set("test"), disturb=True, seed=0, trials_per_object=25,
-                          shard=shard, progress=False)
+    trials = run_shard(policy, True, shard)
     assert len(trials) == len(forces)
     return [dict(t, **f) for t, f in zip(trials, forces)]
 

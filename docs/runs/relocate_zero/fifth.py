@@ -7,7 +7,7 @@ full-protocol runs), then pairs the result with the zero action and the shipped 
 
     python docs/runs/relocate_zero/fifth.py POLICY OUT.json [--disturb]
 
-``squeeze.py`` runs its scripted grips through the same functions. 6-10 min on the 2-core VM.
+``squeeze.py`` and ``../relocate_dist/force_vs_drop.py`` run through the same functions. 2.5 min alone on the 2-core VM.
 """
 import argparse
 import json
@@ -21,13 +21,13 @@ import torch
 
 ROOT = Path(__file__).resolve().parents[3]
 sys.path.insert(0, str(ROOT / "docs/runs/paper_protocol"))
-from paired import mcnemar_exact, newcombe_paired  # noqa: E402
+from paired import mcnemar_exact, newcombe_paired, paired_cells  # noqa: E402
 
 SHARDS = [(0, 10), (5, 10)]  # objects 0 mod 10 and 5 mod 10: together index 0 mod 5, one process each
 
 
-def _shard(policy, disturb, shard):
-    """Trials of one shard; ``policy`` is a ``--policy`` spec or a picklable policy function."""
+def run_shard(policy, disturb, shard):
+    """Trials of one shard, in this process; ``policy`` is a ``--policy`` spec or a policy function."""
     torch.set_num_threads(1)
     from unicross.evaluation import resolve_policy, run_protocol
     from unicross.objects import get_object_set
@@ -40,7 +40,7 @@ def _shard(policy, disturb, shard):
 def run_fifth(policy, disturb: bool):
     """All 2,000 trials, on two processes."""
     with ProcessPoolExecutor(len(SHARDS), mp_context=mp.get_context("spawn")) as ex:
-        parts = list(ex.map(partial(_shard, policy, disturb), SHARDS))
+        parts = list(ex.map(partial(run_shard, policy, disturb), SHARDS))
     return [t for part in parts for t in part]
 
 
@@ -56,10 +56,7 @@ def report(trials, label: str, disturb: bool):
         full = read_results(ROOT / f"docs/runs/paper_protocol/{name}.json.gz")["trials"]["relocate"]
         other = {key(t): t for t in full if key(t) in mine}
         assert len(other) == len(mine), name
-        cells = [0, 0, 0, 0]  # both, only this, only the other, neither
-        for k, t in mine.items():
-            s, o = t["success"], other[k]["success"]
-            cells[0 if s and o else 1 if s else 2 if o else 3] += 1
+        cells = paired_cells((t["success"], other[k]["success"]) for k, t in mine.items())
         lo, hi = newcombe_paired(*cells)
         n = len(mine)
         print(f"  against {name}: {100 * (cells[0] + cells[2]) / n:.1f}% there; this - it "

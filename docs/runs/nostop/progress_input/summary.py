@@ -8,7 +8,7 @@ import json
 import sys
 
 sys.path.insert(0, "docs/runs/paper_protocol")
-from paired import mcnemar_exact, newcombe_paired  # noqa: E402
+from paired import mcnemar_exact, newcombe_paired, paired_cells  # noqa: E402
 
 from unicross.metrics import wilson_interval as wilson  # noqa: E402
 
@@ -20,11 +20,7 @@ def load(path):
 
 def compare(runs, others, name):
     """Pairs run i's trials with others[i]'s and prints the pooled rates and their difference."""
-    a = b = c = d = 0
-    for r, o in zip(runs, others):
-        for k, t in r.items():
-            x, y = bool(t["success"]), bool(o[k]["success"])
-            a, b, c, d = a + (x and y), b + (x and not y), c + (y and not x), d + (not x and not y)
+    a, b, c, d = paired_cells((t["success"], o[k]["success"]) for r, o in zip(runs, others) for k, t in r.items())
     n = a + b + c + d
     lo, hi = newcombe_paired(a, b, c, d)
     wl, wh = wilson(a + b, n)
