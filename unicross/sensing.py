@@ -58,24 +58,21 @@ class HandObjectSensor:
             imp = self._query.cuda_impulses.torch().view(self.num_links, self.scene.num_envs, 3)
             return imp.transpose(0, 1) / dt
         obj, lookup = self._obj_body, self._link_of_body
-        links, signs, impulses = [], [], []
-        for c in self.scene.px.get_contacts():  # one pass; numpy work once for all points
+        out = np.zeros((self.num_links, 3), dtype=np.float32)
+        for c in self.scene.px.get_contacts():  # one pass, each point's impulse added in place to its link's row
             b0, b1 = c.bodies
             if b0 is obj:
-                sign, link = -1.0, lookup.get(b1)
+                link = lookup.get(b1)
+                if link is not None:
+                    row = out[link]
+                    for p in c.points:
+                        row -= p.impulse
             elif b1 is obj:
-                sign, link = 1.0, lookup.get(b0)
-            else:
-                continue
-            if link is None:
-                continue
-            points = c.points
-            impulses.extend([p.impulse for p in points])
-            links.extend([link] * len(points))
-            signs.extend([sign] * len(points))
-        out = np.zeros((self.num_links, 3), dtype=np.float32)
-        if impulses:  # summed point by point in contact order, as a per-point loop would
-            np.add.at(out, links, np.asarray(impulses, dtype=np.float32) * np.asarray(signs, dtype=np.float32)[:, None])
+                link = lookup.get(b0)
+                if link is not None:
+                    row = out[link]
+                    for p in c.points:
+                        row += p.impulse
         return torch.from_numpy(out / dt)[None]
 
     def apply_object_force(self, force) -> None:
