@@ -318,7 +318,7 @@ class UniCrossEnv(TaskScene, EpisodeStarts, StepMath, TaskStateIO, BaseEnv):
         self._stepped = True
         if self._thin_step:
             self._step_action(None)  # drive targets are set; ManiSkill runs the substeps and hooks
-            self._elapsed_steps += 1
+            self._elapsed_steps.add_(self._one_step)  # a made tensor: ~3 us less than wrapping the Python 1
             info = self.get_info()
             obs, reward, terminated, truncated = self._step_out
             if self._obs_mode == "state_dict":

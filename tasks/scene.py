@@ -203,6 +203,7 @@ class TaskScene:
         self.hand_vel = z3.clone()
         self.hand_angvel = z3.clone()
         self._pending = torch.zeros(n, dtype=torch.bool, device=dev)
+        self._one_step = torch.ones((), dtype=torch.int32, device=dev)  # elapsed_steps' increment, made once
         self._stepped = False
         self.link_force = torch.zeros(n, len(self.contact_links), device=dev)
         self._gen = torch.Generator(device=dev)
