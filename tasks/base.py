@@ -280,11 +280,15 @@ class UniCrossEnv(TaskScene, EpisodeStarts, StepMath, TaskStateIO, BaseEnv):
         return torch.cat([self.command, self._follow(self.command)], dim=-1)
 
     def _apply_command(self, targets: Optional[torch.Tensor] = None):
-        """Write the PD targets of all driven joints (``_drive_targets()`` unless given): one write on
-        GPU, raw joints on CPU."""
+        """Write the PD targets of all driven joints of every env (``_drive_targets()`` unless given,
+        [N, driven joints]): one write on GPU, raw joints on CPU. On the GPU the write goes to PhysX's
+        target buffer directly: ManiSkill's ``set_joint_drive_targets`` keeps only the rows of the envs
+        being reset while a reset runs, which full-batch targets (a partial reset to recorded states
+        through ``set_state_dict``) would not fit."""
         targets = self._drive_targets() if targets is None else targets
         if self.gpu_sim_enabled:
-            self.agent.robot.set_joint_drive_targets(targets, joint_indices=self._drive_idx)
+            gx, gy = self.agent.robot.get_joint_target_indices(self._drive_idx)
+            self.scene.px.cuda_articulation_target_qpos.torch()[gx, gy] = targets
             self.scene.px.gpu_apply_articulation_target_position()
         else:
             for joint, target in zip(self._cpu_joints, targets[0].tolist()):

@@ -8,7 +8,9 @@ Both backends return the same tensors on the env device:
   * ``apply_object_force(f)`` applies an external force to the object for the next sim step.
 On the GPU we use one pair-impulse query for all (link, object) pairs of all envs; on the CPU
 (one env per process) we read all contacts in one pass and accumulate per link, which costs a
-fraction of per-pair queries.
+fraction of per-pair queries. Positions are in each env's own frame on both backends: with
+ManiSkill's ``parallel_in_single_scene`` (every GPU env in one viewer) PhysX holds them with the
+envs' scene offsets added, which the GPU read subtracts, as ManiSkill's own pose getters do.
 """
 from __future__ import annotations
 
@@ -31,6 +33,11 @@ class HandObjectSensor:
             self._obj_index = obj._body_data_index.to(self.device)
             pairs = [(link._bodies[e], obj._bodies[e]) for link in links for e in range(scene.num_envs)]
             self._query = scene.px.gpu_create_contact_pair_impulse_query(pairs)
+            self._offsets = None  # [N, B, 3] scene offsets of the bodies' envs, where PhysX adds them
+            if getattr(scene, "parallel_in_single_scene", False):
+                idx = torch.cat([b._scene_idxs for b in bodies]).to(self.device)
+                self._offsets = scene.scene_offsets[idx].to(torch.float32).view(
+                    len(bodies), scene.num_envs, 3).transpose(0, 1)
         else:
             self._components = [b._bodies[0] for b in bodies]
             # contacts name their bodies by component; SAPIEN hands back the same Python object for a
@@ -44,7 +51,8 @@ class HandObjectSensor:
         if self.gpu:
             data = self.scene.px.cuda_rigid_body_data.torch()[self._index, :7]  # [B*N, 7], body-major
             data = data.view(self._num_bodies, self.scene.num_envs, 7).transpose(0, 1)
-            return data[..., :3], data[..., 3:]
+            pos = data[..., :3] if self._offsets is None else data[..., :3] - self._offsets
+            return pos, data[..., 3:]
         # a Pose's 7 numbers as one tuple (its pickle state) instead of two numpy arrays: 137 -> 40 us
         # a step for the 23 bodies of the Allegro hand; float32 -> float -> float32 is exact
         data = torch.from_numpy(np.array([c.entity_pose.__getstate__() for c in self._components],
