@@ -48,13 +48,13 @@ from unicross import formulation as F
 def _rollouts(gait: str, hand: str, objects: str, limit: int, trials: int, seed: int, randomize: bool,
               student, shard, beta: float = 0.0, privileged_q0: bool = False, clock: bool = False,
               history: int = 0, sequence: str = None, mode: str = None, grasps: str = None,
-              accumulated: bool = False) -> tuple:
+              accumulated: bool = False, sim: dict = None) -> tuple:
     """One worker's share: (obs dict of [N, d], labels [N, A], trials) of the protocol of the gait's mode
     on its objects, the gait acting (``student`` None) or the student's mean acting while the gait labels
     (with ``sequence``, a finger sequence of :mod:`unicross.sequences` on ``mode``'s protocol instead);
     with ``beta`` > 0 the gait's own action is taken instead at that fraction of the steps (each env
     and step drawn on its own: DAgger's mixture policy). ``grasps``: the grasp-state dataset the episodes
-    start from (None: the hand's shipped one)."""
+    start from (None: the hand's shipped one). ``sim``: physics overrides of ``configs/task.yaml``'s ``sim``."""
     torch.set_num_threads(1)
     import unicross  # noqa: F401  (registers the tasks)
     from unicross import evaluation as E
@@ -112,7 +112,7 @@ def _rollouts(gait: str, hand: str, objects: str, limit: int, trials: int, seed:
 
     out = E.run_protocol(skill, policy, get_object_set(objects, limit=limit), hand=hand, trials_per_object=trials,
                          seed=seed, randomize=randomize, axes=[axis], progress=False, shard=shard,
-                         grasp_dataset=grasps)
+                         grasp_dataset=grasps, sim=sim)
     return {k: torch.cat(v) for k, v in rows.items()}, torch.cat(labels), out
 
 
@@ -160,13 +160,16 @@ def main(argv=None) -> int:
                          "--trials-per-object 3 --seed 0`; 20: the 120-trial held-out cell), written to "
                          "OUT/heldout.json; also for diagnosis runs, whose networks no checkpoint can hold (0: skip)")
     ap.add_argument("--heldout-objects", default="test")
+    ap.add_argument("--sim", action="append", metavar="KEY=VALUE",
+                    help="physics other than configs/task.yaml's sim section (repeatable), e.g. "
+                         "solver_position_iterations=12; recorded in the checkpoint, whose evaluation then runs under it")
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--out", required=True)
     args = ap.parse_args(argv)
 
     import unicross  # noqa: F401
-    from unicross.config import load_config
+    from unicross.config import load_config, parse_sim_overrides
     from unicross.gaits import gait_mode, make_gait_policy
     from unicross.grasps import grasp_dataset_file
     from unicross.metrics import wilson_interval
@@ -186,6 +189,9 @@ def main(argv=None) -> int:
         mode = gait_mode(make_gait_policy(args.gait).gait_row)
     skill, axis = mode.split("_")
     cfg = load_config("ppo")
+    sim = parse_sim_overrides(args.sim)
+    if sim:
+        cfg["env"]["task_config"] = dict(cfg["env"].get("task_config") or {}, sim=sim)
     if args.obs_std_min is not None:
         if args.obs_std_min < 0:
             ap.error("--obs-std-min must be >= 0")
@@ -213,7 +219,7 @@ def main(argv=None) -> int:
             return [f.result() for f in [ex.submit(_rollouts, args.gait, args.hand, objects, limit, trials, seed,
                                                     randomize, student, (i, args.workers), beta, args.privileged_q0,
                                                     args.clock, args.history, args.sequence, mode, args.grasps,
-                                                    args.progress)
+                                                    args.progress, sim)
                                           for i in range(args.workers)]]
 
     for r in range(args.rounds + 1):

@@ -217,3 +217,36 @@ def test_a_residual_checkpoint_acts_on_top_of_its_gait_and_is_refused_as_a_dagge
     torch.save(ck, tmp_path / "rotate_y-" / "checkpoint.pt")
     with pytest.raises(ValueError, match="networks alone"):
         Teachers({"rotate_y-": tmp_path / "rotate_y-" / "checkpoint.pt"}, "cpu")
+
+
+def test_eval_sim_overrides_are_checked_applied_and_recorded(tmp_path, capsys, grasp_file):
+    """``--sim KEY=VALUE`` builds every env of the evaluation with other physics than configs/task.yaml's,
+    refuses unknown keys and impossible values before simulating, and is recorded in the result."""
+    from unicross.config import parse_sim_overrides
+    assert parse_sim_overrides(["solver_position_iterations=12", "contact_offset=0.01"]) == \
+        dict(solver_position_iterations=12, contact_offset=0.01)
+    assert parse_sim_overrides(None) == {}
+    for bad, msg in (("solver_iterations=12", "KEY one of"), ("solver_position_iterations", "KEY one of"),
+                     ("solver_position_iterations=1.5", "an integer"), ("solver_position_iterations=0", ">= 1"),
+                     ("contact_offset=-0.01", "> 0")):
+        with pytest.raises(ValueError, match=msg):
+            parse_sim_overrides([bad])
+    out = tmp_path / "e.json"
+    assert cli(["eval", "--policy", "zero", "--protocol", "translate", "--sim", "solver_iterations=3",
+                "--out", str(out)]) == 2
+    assert "KEY one of" in capsys.readouterr().err and not out.exists()
+    obj = get_object_set("train-elongated", limit=1)[0]
+    env = E._env_for("translate", "z+", obj, "allegro", disturb=False, randomize=False, grasp_dataset=str(grasp_file),
+                     original=False, sim=dict(solver_position_iterations=12))
+    u = env.unwrapped
+    assert u.cfg["sim"]["solver_position_iterations"] == 12
+    assert u.sim_config.scene_config.solver_position_iterations == 12
+    assert u.agent.robot._objs[0].get_solver_position_iterations() == 12  # PhysX's own setting of the hand
+    env.close()
+    args = ["eval", "--policy", "zero", "--protocol", "translate", "--objects", "train", "--limit", "1",
+            "--trials-per-object", "1", "--axis", "z+", "--grasps", str(grasp_file), "--seed", "1"]
+    assert cli(args + ["--sim", "solver_position_iterations=12", "--out", str(out)]) == 0
+    r = json.loads(out.read_text())
+    assert r["sim"] == dict(solver_position_iterations=12)
+    assert cli(args + ["--out", str(tmp_path / "d.json")]) == 0
+    assert "sim" not in json.loads((tmp_path / "d.json").read_text())  # recorded only where it differs

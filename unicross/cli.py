@@ -310,6 +310,7 @@ def default_label(policy: str) -> str:
 
 
 def _cmd_eval(args) -> int:
+    from unicross.config import parse_sim_overrides
     from unicross import evaluation as E
     from unicross.objects import get_object_set
     protocols = list(E.PROTOCOLS) if args.protocol == "all" else args.protocol.split(",")
@@ -350,10 +351,13 @@ def _cmd_eval(args) -> int:
             raise ValueError(f"checkpoint {args.policy} was trained with ablation {trained or 'none'}; "
                              f"it is evaluated with the switches it was trained with (drop --ablation)")
         ablation = {f: True for f in args.ablation}
+    sim = dict(desc.get("sim") or {}, **parse_sim_overrides(args.sim))  # a checkpoint's own physics, then --sim
     label = args.label or default_label(args.policy)
     result = dict(label=label, policy=desc, objects=args.objects, limit=args.limit, hand=args.hand,
                   trials_per_object=args.trials_per_object, seed=args.seed, axes=axes, disturb=args.disturb,
                   original=args.original, randomize=args.randomize, ablation=ablation or {}, summaries={}, trials={})
+    if sim:  # recorded only where the physics is not configs/task.yaml's
+        result["sim"] = sim
     out = Path(args.out)
     if args.resume and out.is_file():  # the protocols a stopped evaluation finished are kept
         done = json.loads(out.read_text())
@@ -372,7 +376,8 @@ def _cmd_eval(args) -> int:
                                         randomize=args.randomize, grasp_dataset=args.grasps, original=args.original,
                                         videos=args.videos,
                                         video_dir=Path(args.out).parent / (Path(args.out).stem + "_videos"),
-                                        ablation=ablation, **({"axes": axes} if axes and p in with_axes else {}))
+                                        ablation=ablation, sim=sim or None,
+                                        **({"axes": axes} if axes and p in with_axes else {}))
         result["trials"][p] = trials
         result["summaries"][p] = E.summarize(p, trials)
         _write_eval(out, result)  # each finished protocol is on disk before the next starts
@@ -577,6 +582,10 @@ def main(argv=None) -> int:
     s.add_argument("--ablation", action="append", metavar="FLAG",
                    help="evaluate zero/scripted policies under one of the paper's ablations (repeatable; a "
                         "checkpoint always runs with the switches it was trained with): " + ", ".join(ABLATIONS))
+    s.add_argument("--sim", action="append", metavar="KEY=VALUE",
+                   help="physics other than configs/task.yaml's sim section (repeatable), e.g. "
+                        "solver_position_iterations=12; a checkpoint trained under other physics runs under its own "
+                        "unless this says otherwise; recorded in --out")
     s.add_argument("--workers", type=positive, default=1,
                    help="processes to split the objects over (same trials for any number; one env per process)")
     s.add_argument("--out", required=True, help="JSON with every trial (+ .md table), written after each protocol")

@@ -72,6 +72,7 @@ def _checked(key: str, default, value):
 # must be ordered.
 RANGES = {
     "task": {"sim.sim_freq": (0, False), "sim.control_freq": (0, False), "sim.contact_offset": (0, False),
+             "sim.solver_position_iterations": (1, True), "sim.solver_velocity_iterations": (0, True),
              "randomization.mass": (0, False), "randomization.friction": (0, True),
              "randomization.joint_obs_noise": (0, True), "randomization.perturb_scale": (0, True),
              "randomization.perturb_prob": (0, True), "disturbance.max_scale": (0, True),
@@ -128,6 +129,25 @@ def load_config(name: str, overrides: Optional[Mapping[str, Any]] = None) -> dic
     cfg = deep_merge(data, overrides)
     validate_ranges(name, cfg)
     return cfg
+
+
+def parse_sim_overrides(pairs) -> dict:
+    """``KEY=VALUE`` strings -> overrides of ``configs/task.yaml``'s ``sim`` section (the physics every
+    env of a run is built with, e.g. ``solver_position_iterations=12``). Each key must be one of that
+    section's and each value a number of its type; ranges are checked as the task checks them."""
+    sim = load_config("task")["sim"]
+    out = {}
+    for pair in pairs or ():
+        key, eq, value = str(pair).partition("=")
+        if not eq or key not in sim:
+            raise ValueError(f"--sim {pair!r}: expected KEY=VALUE with KEY one of {sorted(sim)}")
+        kind = type(sim[key])
+        try:
+            out[key] = kind(value) if kind is float else int(value)
+        except ValueError:
+            raise ValueError(f"--sim {pair!r}: {key} takes {'a number' if kind is float else 'an integer'}") from None
+    load_config("task", {"sim": out})  # out-of-range values fail here, before any simulation
+    return out
 
 
 def preset_names() -> list:

@@ -227,6 +227,8 @@ def resolve_policy(spec: str, hand: str, seed: int = 0):
     base = base_policy_of(ck)  # a residual policy acts on top of its gait (refused for another hand above)
     desc = dict(kind="checkpoint", path=str(spec), skill=ck.get("skill"), axis=ck.get("axis"),
                 git_commit=ck.get("git_commit"), ablation=task_config.get("ablation", {}))
+    if task_config.get("sim"):  # trained under other physics than configs/task.yaml's
+        desc["sim"] = dict(task_config["sim"])
     if base is not None:
         desc["base_policy"] = base
     return policy_fn(policy.module[0].module, base), desc
@@ -234,9 +236,11 @@ def resolve_policy(spec: str, hand: str, seed: int = 0):
 
 # ----------------------------------------------------------------------------- one protocol
 def _env_for(protocol: str, axis: Optional[str], obj: ObjectSpec, hand: str, disturb: bool, randomize: bool,
-             grasp_dataset, original: bool, ablation: Optional[dict] = None):
+             grasp_dataset, original: bool, ablation: Optional[dict] = None, sim: Optional[dict] = None):
     sk = R.skill(protocol)
     cfg = dict(episode_length={protocol: sk.protocol_steps})
+    if sim:  # physics other than configs/task.yaml's (unicross eval --sim)
+        cfg["sim"] = dict(sim)
     if ablation:  # a policy trained without some inputs is evaluated with the same switches
         cfg["ablation"] = dict(ablation)
     if disturb:
@@ -280,9 +284,11 @@ def run_protocol(protocol: str, policy: PolicyFn, objects: Sequence[ObjectSpec],
                  trials_per_object: int = EVAL_CFG["trials_per_object"], seed: int = 0, disturb: bool = False, randomize: bool = False,
                  grasp_dataset=None, original: bool = False, progress: bool = True,
                  videos: int = 0, video_dir=None, ablation: Optional[dict] = None,
-                 axes: Optional[Sequence[str]] = None, shard: Optional[Tuple[int, int]] = None) -> List[dict]:
+                 axes: Optional[Sequence[str]] = None, shard: Optional[Tuple[int, int]] = None,
+                 sim: Optional[dict] = None) -> List[dict]:
     """All trials of one protocol; returns one dict per trial. The first ``videos`` trials are
-    recorded as trajectory files (and rendered to mp4) in ``video_dir``. ``axes`` restricts
+    recorded as trajectory files (and rendered to mp4) in ``video_dir``. ``sim`` overrides the
+    physics of ``configs/task.yaml`` (its ``sim`` section). ``axes`` restricts
     rotate/translate to some of the protocol's axes (default: all). ``shard=(i, n)`` runs only the
     objects whose index is i modulo n; every trial is seeded from its object's index in the whole
     list, so n shards together give exactly the trials of one unsharded run."""
@@ -303,7 +309,7 @@ def run_protocol(protocol: str, policy: PolicyFn, objects: Sequence[ObjectSpec],
     for oi in mine:
         obj = objs[oi]
         for axis in axes:
-            env = _env_for(protocol, axis, obj, hand, disturb, randomize, grasp_dataset, original, ablation)
+            env = _env_for(protocol, axis, obj, hand, disturb, randomize, grasp_dataset, original, ablation, sim)
             u = env.unwrapped
             axis_vec = F.MODE_AXES[F.mode_index(protocol, axis)]
             for k in range(trials_per_object):
