@@ -250,3 +250,27 @@ def test_eval_sim_overrides_are_checked_applied_and_recorded(tmp_path, capsys, g
     assert r["sim"] == dict(solver_position_iterations=12)
     assert cli(args + ["--out", str(tmp_path / "d.json")]) == 0
     assert "sim" not in json.loads((tmp_path / "d.json").read_text())  # recorded only where it differs
+
+
+def test_a_checkpoint_made_under_other_physics_is_evaluated_under_its_own(tmp_path, monkeypatch):
+    """A checkpoint whose env config overrides ``sim`` (``gait_clone.py --sim``, ``--set
+    env.task_config.sim...``) is evaluated under that physics unless the caller names one."""
+    from unicross import formulation as F
+    from unicross.config import load_config
+    from unicross.rl.models import make_models
+    from unicross.robots.hand import load_hand
+    spec = load_hand("allegro")
+    dims = dict(hand=2 * spec.dof, object=5 * len(spec.contact_links), goal=F.GOAL_DIM)
+    policy, _, _ = make_models(dims, spec.dof, None, load_config("ppo")["model"])
+    path = tmp_path / "it12.pt"
+    torch.save(dict(policy=policy.state_dict(), obs_dims=dims, n_act=spec.dof, hand="allegro", config=load_config("ppo"),
+                    skill="translate", axis="z+", env_kwargs=dict(config=dict(sim=dict(solver_position_iterations=12)))),
+               path)
+    assert E.resolve_policy(str(path), "allegro")[1]["sim"] == dict(solver_position_iterations=12)
+    seen = []
+    monkeypatch.setattr(E, "run_protocol", lambda *a, **kw: seen.append(kw.get("sim")) or [])
+    objs = get_object_set("train-elongated", limit=1)
+    E.run_protocol_workers("translate", str(path), objs, workers=1)
+    E.run_protocol_workers("translate", str(path), objs, workers=1, sim=dict(solver_position_iterations=16))
+    E.run_protocol_workers("translate", "zero", objs, workers=1)
+    assert seen == [dict(solver_position_iterations=12), dict(solver_position_iterations=16), None]

@@ -357,7 +357,9 @@ def merge_shards(protocol: str, objects: Sequence[ObjectSpec], parts: Sequence[L
 
 def _protocol_shard(spec: str, hand: str, policy_seed: int, protocol: str, objects, kwargs: dict, shard) -> List[dict]:
     torch.set_num_threads(1)
-    policy, _ = resolve_policy(spec, hand, seed=policy_seed)
+    policy, desc = resolve_policy(spec, hand, seed=policy_seed)
+    if kwargs.get("sim") is None:  # a checkpoint made under other physics runs under its own
+        kwargs = dict(kwargs, sim=desc.get("sim"))
     return run_protocol(protocol, policy, objects, hand=hand, shard=shard, progress=False, **kwargs)
 
 
@@ -365,9 +367,12 @@ def run_protocol_workers(protocol: str, spec: str, objects: Sequence[ObjectSpec]
                          workers: int = 1, seed: int = 0, **kwargs) -> List[dict]:
     """:func:`run_protocol` for the policy named by ``spec`` (as ``unicross eval --policy``), split
     over ``workers`` spawned processes (objects i mod n). Trials are seeded per object and trial,
-    so the result is the same for any number of workers (tested)."""
+    so the result is the same for any number of workers (tested). Without ``sim``, a checkpoint
+    made under other physics (its ``env_kwargs`` config's ``sim``) runs under its own."""
     if workers <= 1:
-        policy, _ = resolve_policy(spec, hand, seed=seed)
+        policy, desc = resolve_policy(spec, hand, seed=seed)
+        if kwargs.get("sim") is None:  # a checkpoint made under other physics runs under its own
+            kwargs = dict(kwargs, sim=desc.get("sim"))
         return run_protocol(protocol, policy, objects, hand=hand, seed=seed, **kwargs)
     if kwargs.get("videos"):
         raise ValueError("--videos records the first trials of one process: use --workers 1")

@@ -106,14 +106,16 @@ def adopt_input_floor(model_cfg: dict, ck: dict) -> None:
 
 
 def evaluation_shard(actor, skill: str, objects: str, limit, trials_per_object: int, seed: int, hand: str,
-                     axis: Optional[str], ablation: Optional[dict], shard, base_policy: Optional[str] = None) -> list:
-    """One worker's share of a held-out evaluation (see :meth:`PPOTrainer._protocol`)."""
+                     axis: Optional[str], ablation: Optional[dict], shard, base_policy: Optional[str] = None,
+                     sim: Optional[dict] = None) -> list:
+    """One worker's share of a held-out evaluation (see :meth:`PPOTrainer._protocol`), under the run's
+    physics (``sim``: its ``env.task_config.sim`` overrides)."""
     from unicross import evaluation as E
     from unicross.objects import get_object_set
     from unicross.rl.policy_io import policy_fn
     return E.run_protocol(skill, policy_fn(actor, base_policy), get_object_set(objects, limit=limit),
                           hand=hand, trials_per_object=trials_per_object, seed=seed, progress=False,
-                          axes=[axis] if axis else None, ablation=ablation, shard=shard)
+                          axes=[axis] if axis else None, ablation=ablation, shard=shard, sim=sim)
 
 
 class PPOTrainer(Runner):
@@ -248,7 +250,7 @@ class PPOTrainer(Runner):
         shards = self.collector.map_shards(
             evaluation_shard, skill=self.skill, objects=objects, limit=limit, trials_per_object=trials_per_object,
             seed=seed, hand=self.hand, axis=self.axis, ablation=(self.cfg["env"].get("task_config") or {}).get("ablation"),
-            base_policy=self.cfg["model"].get("base_policy"))
+            base_policy=self.cfg["model"].get("base_policy"), sim=(self.cfg["env"].get("task_config") or {}).get("sim"))
         trials = E.merge_shards(self.skill, objs, shards)
         return trials, E.summarize(self.skill, trials)
 
