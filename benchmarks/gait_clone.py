@@ -189,7 +189,10 @@ def main(argv=None) -> int:
         mode = gait_mode(make_gait_policy(args.gait).gait_row)
     skill, axis = mode.split("_")
     cfg = load_config("ppo")
-    sim = parse_sim_overrides(args.sim)
+    try:
+        sim = parse_sim_overrides(args.sim)  # a bad --sim fails here, before any simulation
+    except ValueError as e:
+        ap.error(str(e))
     if sim:
         cfg["env"]["task_config"] = dict(cfg["env"].get("task_config") or {}, sim=sim)
     if args.obs_std_min is not None:

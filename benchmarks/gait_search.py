@@ -86,6 +86,7 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 from unicross.gaits import gait_targets, layout_of, phase_cycle, phase_offsets  # noqa: E402
+from unicross.config import parse_sim_overrides  # noqa: E402
 _ENVS = {}
 
 
@@ -100,7 +101,8 @@ def _objects(skill: str, name: str, limit: int, hand: str, grasps=None) -> list:
 
 
 def _env(job):
-    key = (job["hand"], job["skill"], job["axis"], job["objects"], job["limit"], job["oi"], job["randomize"], job["grasps"])
+    key = (job["hand"], job["skill"], job["axis"], job["objects"], job["limit"], job["oi"], job["randomize"], job["grasps"],
+           job["sim"])
     if key not in _ENVS:
         import gymnasium as gym
         import unicross  # noqa: F401  (registers the tasks)
@@ -113,6 +115,8 @@ def _env(job):
         kw["randomize"] = job["randomize"]
         if job["grasps"] is not None:
             kw["grasp_dataset"] = job["grasps"]
+        if job["sim"]:  # physics other than configs/task.yaml's (--sim)
+            kw["config"] = dict(kw.get("config") or {}, sim=dict(job["sim"]))
         obj = _objects(job["skill"], job["objects"], job["limit"], job["hand"], job["grasps"])[job["oi"]]
         _ENVS[key] = gym.make(skill_entry(job["skill"]).env_id, obs_mode="state", sim_backend="physx_cpu",
                               render_backend="none", num_envs=1, **{**kw, "objects": [obj]})
@@ -177,7 +181,8 @@ def evaluate(pool, gaits, args, n_obj, first: int = 0, hold=None, seeds=None, pa
     jobs = [dict(p=p.tolist(), oi=oi, seed=trial_seed(0, oi, k), hand=args.hand, skill=args.skill, axis=args.axis,
                  objects=args.objects, limit=args.limit, randomize=not args.no_randomize, steps=args.steps,
                  amplitude=args.amplitude, finger=(first + i) % n_fingers if args.one_finger else None, hold=hold,
-                 grasps=args.grasps, tracking=args.tracking, lookahead=args.lookahead, no_stop=args.no_stop)
+                 grasps=args.grasps, tracking=args.tracking, lookahead=args.lookahead, no_stop=args.no_stop,
+                 sim=tuple(sorted(parse_sim_overrides(args.sim).items())))
             for i, p in enumerate(gaits) for oi, k in pairs]
     return np.array(pool.map(episode, jobs, chunksize=1)).reshape(len(gaits), len(pairs), 9)
 
@@ -286,6 +291,9 @@ def main():
                          "or phase (the target --lookahead steps past the cycle's point nearest the joint command, a "
                          "function of the state); logged in the rows' meta, which the gait then runs with")
     ap.add_argument("--lookahead", type=float, default=1.5, help="--tracking phase: control steps ahead on the cycle")
+    ap.add_argument("--sim", action="append", metavar="KEY=VALUE",
+                    help="physics other than configs/task.yaml's sim section (repeatable), e.g. "
+                         "solver_position_iterations=12; logged in the rows' meta, which the gait then runs under")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--out", default=None)
     ap.add_argument("--summary", nargs="+", default=None)
@@ -296,6 +304,10 @@ def main():
         ap.error("--out is required")
     if args.no_stop and not args.hold:
         ap.error("--no-stop scores the protocol's success: it needs --hold (and --refine)")
+    try:
+        parse_sim_overrides(args.sim)  # a bad --sim fails here, before any simulation
+    except ValueError as e:
+        ap.error(str(e))
     args.axis = args.axis or ("z-" if args.skill == "translate" else "x+")
     args.objects = args.objects or ("train-elongated" if args.skill == "translate" else "train-wrappable")
     from multiprocessing import get_context

@@ -1,5 +1,6 @@
 """Evaluation protocols: determinism, the scripted baseline, settings, fail-fast checks."""
 import json
+from pathlib import Path
 
 import pytest
 import torch
@@ -274,3 +275,10 @@ def test_a_checkpoint_made_under_other_physics_is_evaluated_under_its_own(tmp_pa
     E.run_protocol_workers("translate", str(path), objs, workers=1, sim=dict(solver_position_iterations=16))
     E.run_protocol_workers("translate", "zero", objs, workers=1)
     assert seen == [dict(solver_position_iterations=12), dict(solver_position_iterations=16), None]
+    # so does a gait searched under other physics (gait_search.py --sim, logged in its rows' meta)
+    shipped = json.loads((Path(__file__).parents[1] / "unicross/checkpoints/allegro/gaits/rotate_z+.json").read_text())
+    log = tmp_path / "gait.jsonl"
+    log.write_text(json.dumps(dict(meta=dict(shipped["meta"], sim=["solver_position_iterations=12"]), p=shipped["p"],
+                                   score=1.0)) + "\n")
+    assert E.resolve_policy(f"gait:{log}", "allegro")[1]["sim"] == dict(solver_position_iterations=12)
+    assert "sim" not in E.resolve_policy("gait:allegro/rotate_z+", "allegro")[1]

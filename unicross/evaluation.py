@@ -210,8 +210,12 @@ def resolve_policy(spec: str, hand: str, seed: int = 0):
         policy = make_gait_policy(path)  # a missing file or a gait of the wrong length fails here, before any simulation
         if gait_hand(policy.gait_row) != hand:
             raise ValueError(f"policy {spec!r} is a gait for hand {gait_hand(policy.gait_row)!r}, not {hand!r}")
-        return policy, dict(kind="gait", path=path, mode=gait_mode(policy.gait_row), gait=policy.gait_row["p"],
-                            meta=policy.gait_row.get("meta", {}))
+        desc = dict(kind="gait", path=path, mode=gait_mode(policy.gait_row), gait=policy.gait_row["p"],
+                    meta=policy.gait_row.get("meta", {}))
+        if desc["meta"].get("sim"):  # searched under other physics (gait_search.py --sim): runs under its own
+            from unicross.config import parse_sim_overrides
+            desc["sim"] = parse_sim_overrides(desc["meta"]["sim"])
+        return policy, desc
     from unicross.rl.policy_io import base_policy_of, load_policy, policy_fn
     from unicross.robots.hand import load_hand
     policy, ck = load_policy(spec)
