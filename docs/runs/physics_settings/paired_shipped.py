@@ -1,8 +1,10 @@
-"""The shipped rotate clones on their 120-trial held-out cells, under 8 iterations (their evaluations when
-shipped, named in each sidecar) against 12 (runs of `unicross eval ... --sim solver_position_iterations=12`),
-paired trial by trial (the same objects, starts and seeds):
+"""The shipped rotate clones (or, with ``--gaits``, the shipped scripted gaits) on their 120-trial held-out
+cells, under 8 iterations (their evaluations when shipped, named in each sidecar) against 12 (runs of
+`unicross eval ... --sim solver_position_iterations=12` in DIR, files ``shipped_AXIS.json[.gz]`` or
+``gait_AXIS.json[.gz]``), paired trial by trial (the same objects, starts and seeds):
 
-    python docs/runs/physics_settings/paired_shipped.py DIR_OF_12   # e.g. docs/runs/physics_settings/shipped_it12
+    python docs/runs/physics_settings/paired_shipped.py docs/runs/physics_settings/shipped_it12
+    python docs/runs/physics_settings/paired_shipped.py docs/runs/physics_settings/gaits_it12 --gaits
 """
 import gzip
 import json
@@ -19,6 +21,12 @@ AT8 = {"x+": "docs/runs/gait_clone/rotate_x+_beta_floor1e-2/heldout",
        "y-": "docs/runs/nostop/clone_y-_shipped/eval_test120",
        "z+": "docs/runs/nostop/clone_z+_shipped/eval_test120",
        "z-": "docs/runs/nostop/clone_z-_shipped/eval_test120"}
+GAITS_AT8 = {"x+": "docs/runs/gait_search/heldout/rotate_x+_sampled",
+             "x-": "docs/runs/gait_search/heldout/rotate_x-_sampled",
+             "y+": "docs/runs/gait_search/heldout/rotate_y+",
+             "y-": "docs/runs/gait_search/heldout/rotate_y-_phase",
+             "z+": "docs/runs/gait_search/heldout/rotate_z+",
+             "z-": "docs/runs/gait_search/heldout/rotate_z-"}
 
 
 def trials(path):
@@ -29,11 +37,13 @@ def trials(path):
 
 def main():
     d12 = Path(sys.argv[1])
+    gaits = "--gaits" in sys.argv[2:]
+    at8, prefix = (GAITS_AT8, "gait") if gaits else (AT8, "shipped")
     pairs_all = []
     print("| axis | 8 iterations | 12 iterations | dropped (8 / 12) | paired difference [95% CI] | McNemar p |")
     print("|---|---|---|---|---|---|")
-    for axis, f8 in AT8.items():
-        a, b = trials(ROOT / f8), trials(next(d12.glob(f"shipped_{axis}.json*")))
+    for axis, f8 in at8.items():
+        a, b = trials(ROOT / f8), trials(next(d12.glob(f"{prefix}_{axis}.json*")))
         assert a.keys() == b.keys(), axis
         pairs = [(b[k]["success"], a[k]["success"]) for k in a]
         pairs_all += pairs
