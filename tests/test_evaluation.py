@@ -282,3 +282,30 @@ def test_a_checkpoint_made_under_other_physics_is_evaluated_under_its_own(tmp_pa
                                    score=1.0)) + "\n")
     assert E.resolve_policy(f"gait:{log}", "allegro")[1]["sim"] == dict(solver_position_iterations=12)
     assert "sim" not in E.resolve_policy("gait:allegro/rotate_z+", "allegro")[1]
+
+
+def test_experts_made_under_other_physics_run_under_it_and_mixed_physics_is_refused(tmp_path):
+    """``--policy experts:DIR`` acts with every mode's expert in one env: experts made under other
+    physics than configs/task.yaml's run under it, and experts made under different physics are refused."""
+    from unicross import formulation as F
+    from unicross.config import load_config
+    from unicross.rl.models import make_models
+    from unicross.robots.hand import load_hand
+    spec = load_hand("allegro")
+    dims = dict(hand=2 * spec.dof, object=5 * len(spec.contact_links), goal=F.GOAL_DIM)
+    policy, _, _ = make_models(dims, spec.dof, None, load_config("ppo")["model"])
+    state = policy.state_dict()
+
+    def write(sims):
+        for m in F.MODES:
+            skill, _, axis = m.partition("_")
+            (tmp_path / m).mkdir(exist_ok=True)
+            torch.save(dict(policy=state, obs_dims=dims, n_act=spec.dof, hand="allegro", config=load_config("ppo"),
+                            skill=skill, axis=axis or None, env_kwargs=dict(config=dict(sim=sims(m)))),
+                       tmp_path / m / "checkpoint.pt")
+    write(lambda m: dict(solver_position_iterations=12))
+    assert E.resolve_policy(f"experts:{tmp_path}", "allegro")[1]["sim"] == dict(solver_position_iterations=12)
+    write(lambda m: dict(solver_position_iterations=12) if m != "grasp" else {})
+    with pytest.raises(ValueError, match="different physics"):
+        E.resolve_policy(f"experts:{tmp_path}", "allegro")
+    assert "sim" not in E.resolve_policy("experts:allegro", "allegro")[1]

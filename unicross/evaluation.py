@@ -152,13 +152,19 @@ def expert_specs(source: str, hand: str) -> Dict[str, str]:
 def make_experts_policy(source: str, hand: str, seed: int = 0) -> Tuple[PolicyFn, dict]:
     """The per-mode experts as one policy: each env is acted on by the expert of its current mode
     (the task's ``mode``, which the goal's one-hot shows the networks), so a long-horizon chain
-    switches expert at each phase boundary: the teachers' side of the student's chain."""
+    switches expert at each phase boundary: the teachers' side of the student's chain. Experts made
+    under other physics than ``configs/task.yaml``'s run under it; experts made under different physics
+    are refused."""
     specs = expert_specs(source, hand)
     loaded = {m: resolve_policy(s, hand, seed) for m, s in specs.items()}  # each checked against the hand
     for m, (_, desc) in loaded.items():
         trained = R.trained_mode(desc.get("skill"), desc.get("axis"))
         if trained != m:
             raise ValueError(f"policy experts:{source}: {specs[m]} was trained for mode {trained!r}, not {m!r}")
+    sims = {json.dumps(desc.get("sim") or {}, sort_keys=True) for _, desc in loaded.values()}
+    if len(sims) > 1:  # one env (one physics) serves every mode's expert
+        raise ValueError(f"policy experts:{source}: the experts were made under different physics "
+                         f"({sorted(sims)}); one evaluation runs them under one")
     policies = {F.MODES.index(m): fn for m, (fn, _) in loaded.items()}
 
     def policy(obs, u):
@@ -168,7 +174,11 @@ def make_experts_policy(source: str, hand: str, seed: int = 0) -> Tuple[PolicyFn
             a = policies[i](obs, u)
             out = a if out is None else torch.where((mode == i)[:, None], a, out)
         return out
-    return policy, dict(kind="experts", source=source, experts=specs)
+    desc = dict(kind="experts", source=source, experts=specs)
+    sim = json.loads(sims.pop())
+    if sim:  # made under other physics than configs/task.yaml's: they run under it
+        desc["sim"] = sim
+    return policy, desc
 
 
 def reference_fraction(spec: str) -> Optional[float]:
