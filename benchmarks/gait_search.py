@@ -182,7 +182,7 @@ def evaluate(pool, gaits, args, n_obj, first: int = 0, hold=None, seeds=None, pa
                  objects=args.objects, limit=args.limit, randomize=not args.no_randomize, steps=args.steps,
                  amplitude=args.amplitude, finger=(first + i) % n_fingers if args.one_finger else None, hold=hold,
                  grasps=args.grasps, tracking=args.tracking, lookahead=args.lookahead, no_stop=args.no_stop,
-                 sim=tuple(sorted(parse_sim_overrides(args.sim).items())))
+                 sim=args.sim_pairs)
             for i, p in enumerate(gaits) for oi, k in pairs]
     return np.array(pool.map(episode, jobs, chunksize=1)).reshape(len(gaits), len(pairs), 9)
 
@@ -304,8 +304,8 @@ def main():
         ap.error("--out is required")
     if args.no_stop and not args.hold:
         ap.error("--no-stop scores the protocol's success: it needs --hold (and --refine)")
-    try:
-        parse_sim_overrides(args.sim)  # a bad --sim fails here, before any simulation
+    try:  # a bad --sim fails here, before any simulation; the jobs carry it as hashable pairs
+        args.sim_pairs = tuple(sorted(parse_sim_overrides(args.sim).items()))
     except ValueError as e:
         ap.error(str(e))
     args.axis = args.axis or ("z-" if args.skill == "translate" else "x+")
@@ -314,7 +314,7 @@ def main():
     n_obj = len(_objects(args.skill, args.objects, args.limit, args.hand, args.grasps))
     npar = layout_of(args.hand).npar
     rng = np.random.default_rng(args.seed)
-    meta = {k: v for k, v in vars(args).items() if k not in ("summary", "out")}
+    meta = {k: v for k, v in vars(args).items() if k not in ("summary", "out", "sim_pairs")}
     os.makedirs(os.path.dirname(os.path.abspath(args.out)), exist_ok=True)
     with get_context("spawn").Pool(2) as pool, open(args.out, "a") as log:
         if args.refine is None:

@@ -372,9 +372,13 @@ def merge_shards(protocol: str, objects: Sequence[ObjectSpec], parts: Sequence[L
 def _protocol_shard(spec: str, hand: str, policy_seed: int, protocol: str, objects, kwargs: dict, shard) -> List[dict]:
     torch.set_num_threads(1)
     policy, desc = resolve_policy(spec, hand, seed=policy_seed)
-    if kwargs.get("sim") is None:  # a checkpoint made under other physics runs under its own
-        kwargs = dict(kwargs, sim=desc.get("sim"))
-    return run_protocol(protocol, policy, objects, hand=hand, shard=shard, progress=False, **kwargs)
+    return run_protocol(protocol, policy, objects, hand=hand, shard=shard, progress=False, **_own_physics(kwargs, desc))
+
+
+def _own_physics(kwargs: dict, desc: dict) -> dict:
+    """``kwargs`` of :func:`run_protocol`, with the physics a policy was made under (its description's ``sim``)
+    where the caller named none."""
+    return dict(kwargs, sim=desc.get("sim")) if kwargs.get("sim") is None else kwargs
 
 
 def run_protocol_workers(protocol: str, spec: str, objects: Sequence[ObjectSpec], hand: str = "allegro",
@@ -385,9 +389,7 @@ def run_protocol_workers(protocol: str, spec: str, objects: Sequence[ObjectSpec]
     made under other physics (its ``env_kwargs`` config's ``sim``) runs under its own."""
     if workers <= 1:
         policy, desc = resolve_policy(spec, hand, seed=seed)
-        if kwargs.get("sim") is None:  # a checkpoint made under other physics runs under its own
-            kwargs = dict(kwargs, sim=desc.get("sim"))
-        return run_protocol(protocol, policy, objects, hand=hand, seed=seed, **kwargs)
+        return run_protocol(protocol, policy, objects, hand=hand, seed=seed, **_own_physics(kwargs, desc))
     if kwargs.get("videos"):
         raise ValueError("--videos records the first trials of one process: use --workers 1")
     import multiprocessing as mp

@@ -9,9 +9,9 @@ protocols without axes):
 
     python docs/runs/physics_settings/probe.py POLICY PROTOCOL AXIS OBJECTS LIMIT TRIALS OUT.json [KEY=VALUE ...] [disturb]
 
-Every override applies to the scene the evaluation builds (``unicross.tasks.base`` reads ``configs/task.yaml``
-through ``load_config``, patched here); the grasp states are the shipped dataset's, made under the
-default settings.
+Every override applies to every env the evaluation builds (``run_protocol(sim=...)``, as ``unicross eval --sim``;
+the first runs of 2026-12-04 patched the task's ``load_config`` to the same effect); the grasp states are the
+shipped dataset's, made under the default settings.
 """
 import json
 import sys
@@ -22,28 +22,17 @@ import torch
 
 def main():
     policy_spec, protocol, axis, objects, limit, trials, out = sys.argv[1:8]
-    sim, disturb = {}, "disturb" in sys.argv[8:]
-    for kv in sys.argv[8:]:
-        if kv == "disturb":
-            continue
-        k, v = kv.split("=")
-        sim[k] = type(eval(v))(eval(v))
+    from unicross.config import parse_sim_overrides
+    disturb = "disturb" in sys.argv[8:]
+    sim = parse_sim_overrides([kv for kv in sys.argv[8:] if kv != "disturb"])
     torch.set_num_threads(1)
-    import unicross.tasks.base as base
-    from unicross.config import load_config as _load
-
-    def load_config(name, overrides=None):
-        cfg = _load(name, overrides)
-        if name == "task":
-            cfg["sim"].update(sim)
-        return cfg
-    base.load_config = load_config
     from unicross.evaluation import resolve_policy, run_protocol
     from unicross.objects import get_object_set
     policy, _ = resolve_policy(policy_spec, "allegro")
     t0 = time.time()
     rows = run_protocol(protocol, policy, get_object_set(objects, limit=int(limit)), axes=None if axis == "-" else [axis],
-                        trials_per_object=int(trials), seed=0, disturb=disturb, progress=False)
+                        trials_per_object=int(trials), seed=0, disturb=disturb, progress=False,
+                        sim=sim or None)
     metric = dict(rotate="rotation_rad", translate="translation_cm", relocate="pe_cm").get(protocol)
     kept = [r[metric] for r in rows if not r["dropped"] and metric]
     res = dict(policy=policy_spec, protocol=protocol, axis=axis, objects=objects, limit=int(limit), sim=sim, disturb=disturb,
