@@ -90,6 +90,7 @@ def test_report_raises_trials_to_the_minimum():
     (["report", "--paper", "--min-trials", "-1"], ">= 0"),
     (["report", "--paper", "some.json"], "takes no eval JSON files"),
     (["report"], "--paper"),
+    (["report", "--paper", "--sim", "solver_iterations=12"], "KEY one of"),
 ])
 def test_report_bad_input_fails_before_simulation(argv, msg, capsys):
     assert main(argv) == 2
@@ -99,6 +100,28 @@ def test_report_bad_input_fails_before_simulation(argv, msg, capsys):
 def test_report_out_directory_refused(tmp_path, capsys):
     assert main(["report", "--paper", "--out", str(tmp_path)]) == 2
     assert "is a directory" in capsys.readouterr().err
+
+
+def test_report_sim_reaches_every_cell_and_chain_and_is_printed(tmp_path, monkeypatch):
+    """``report --paper --sim KEY=VALUE`` runs every cell and both long horizons under that physics
+    (overriding each policy's own) and prints it in the command and the header."""
+    from unicross import evaluation as E
+    from unicross import report as Rp
+    seen = []
+    monkeypatch.setattr(E, "run_protocol_workers", lambda *a, **kw: seen.append(("cell", kw.get("sim"))) or [])
+    monkeypatch.setattr(E, "run_chain", lambda *a, **kw: seen.append(("chain", kw.get("sim"))) or [])
+    monkeypatch.setattr(E, "summarize", lambda *a, **kw: dict(successes=0, n=1))
+    monkeypatch.setattr(E, "summarize_chain", lambda *a, **kw: {})
+    monkeypatch.setattr(E, "chain_table", lambda *a, **kw: "")
+    monkeypatch.setattr(E, "chain_last_phase_by_mode", lambda *a, **kw: {})
+    monkeypatch.setattr(Rp, "_cell", lambda *a, **kw: "--")
+    out = tmp_path / "r.md"
+    assert main(["report", "--paper", "--limit", "1", "--sim", "solver_position_iterations=8", "--out", str(out)]) == 0
+    text = out.read_text()
+    assert "--sim solver_position_iterations=8 --out" in text
+    assert "Physics: configs/task.yaml's sim section with solver_position_iterations=8 in every cell." in text
+    kinds = {k for k, _ in seen}
+    assert kinds == {"cell", "chain"} and all(sim == dict(solver_position_iterations=8) for _, sim in seen)
 
 
 def test_paper_values_format():

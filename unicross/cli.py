@@ -434,12 +434,14 @@ def _cmd_report(args) -> int:
 
 
 def _cmd_report_paper(args) -> int:
+    from unicross.config import parse_sim_overrides
     from unicross.report import paper_report
     if args.files:
         raise ValueError("report --paper evaluates the shipped checkpoints; it takes no eval JSON files")
     if args.trials_per_object < 1 or args.limit < 0 or args.workers < 1 or args.min_trials < 0:
         raise ValueError("--trials-per-object and --workers must be >= 1, --limit and --min-trials >= 0 "
                          "(--limit 0: every object)")
+    sim = parse_sim_overrides(args.sim)
     out = Path(args.out or "docs/results.md")
     out.parent.mkdir(parents=True, exist_ok=True)
     if out.is_dir():
@@ -448,9 +450,9 @@ def _cmd_report_paper(args) -> int:
         pass
     argv = ["report", "--paper", "--hand", args.hand, "--limit", str(args.limit), "--trials-per-object",
             str(args.trials_per_object), "--min-trials", str(args.min_trials), "--workers", str(args.workers),
-            "--seed", str(args.seed), "--out", str(out)]
+            "--seed", str(args.seed)] + [a for pair in args.sim or () for a in ("--sim", pair)] + ["--out", str(out)]
     paper_report(str(out), argv, hand=args.hand, limit=args.limit or None, trials=args.trials_per_object,
-                 min_trials=args.min_trials, workers=args.workers, seed=args.seed)
+                 min_trials=args.min_trials, workers=args.workers, seed=args.seed, sim=sim or None)
     print(f"wrote {out}")
     return 0
 
@@ -487,15 +489,18 @@ def _cmd_distill(args) -> int:
 def _cmd_chain(args) -> int:
     from unicross import evaluation as E
     from unicross.objects import get_object_set
+    from unicross.config import parse_sim_overrides
     from unicross.tasks.chain import parse_sequence
     if args.sequence:
         parse_sequence(args.sequence)  # validates before any simulation
+    overrides = parse_sim_overrides(args.sim)
     objs = get_object_set(args.objects, limit=args.limit)
     policy, desc = E.resolve_policy(args.policy, args.hand, seed=args.seed)
+    sim = dict(desc.get("sim") or {}, **overrides)  # the policy's own physics, then --sim
     videos = 1 if args.video else 0
     video_dir = Path(args.video).parent if args.video else None
     trials = E.run_chain(policy, objs, args.sequence, hand=args.hand, trials_per_object=args.trials_per_object,
-                         seed=args.seed, videos=videos, video_dir=video_dir)
+                         seed=args.seed, videos=videos, video_dir=video_dir, sim=sim or None)
     for t in trials:
         phases = ", ".join(f"{m}: {'ok' if s else 'FAIL'}" for m, s in zip(t["sequence"], t["phase_success"]))
         print(f"{t['object']} trial {t['trial']}: {phases} -> {'SUCCESS' if t['overall'] else 'failure'}")
@@ -507,7 +512,8 @@ def _cmd_chain(args) -> int:
             made[0].replace(args.video)
             print(f"video: {args.video}")
     if args.out:
-        Path(args.out).write_text(json.dumps(dict(policy=desc, trials=trials, summary=summary), indent=1))
+        extra = dict(sim=sim) if sim else {}  # recorded only where it differs from configs/task.yaml's
+        Path(args.out).write_text(json.dumps(dict(policy=desc, trials=trials, summary=summary, **extra), indent=1))
     return 0
 
 
@@ -584,8 +590,8 @@ def main(argv=None) -> int:
                         "checkpoint always runs with the switches it was trained with): " + ", ".join(ABLATIONS))
     s.add_argument("--sim", action="append", metavar="KEY=VALUE",
                    help="physics other than configs/task.yaml's sim section (repeatable), e.g. "
-                        "solver_position_iterations=12; a checkpoint trained under other physics runs under its own "
-                        "unless this says otherwise; recorded in --out")
+                        "solver_position_iterations=8 (the default before 2026-12-04); a checkpoint trained under "
+                        "other physics runs under its own unless this says otherwise; recorded in --out")
     s.add_argument("--workers", type=positive, default=1,
                    help="processes to split the objects over (same trials for any number; one env per process)")
     s.add_argument("--out", required=True, help="JSON with every trial (+ .md table), written after each protocol")
@@ -606,6 +612,9 @@ def main(argv=None) -> int:
                    help="--paper: raise the trials per object of a cell until it has at least N trials (0: off)")
     s.add_argument("--workers", type=positive, default=1, help="--paper: processes per evaluation")
     s.add_argument("--seed", type=int, default=0)
+    s.add_argument("--sim", action="append", metavar="KEY=VALUE",
+                   help="--paper: every cell under physics other than configs/task.yaml's sim section (repeatable), "
+                        "as `unicross eval --sim`; printed in the command at the top")
     s.set_defaults(fn=_cmd_report)
     s = sub.add_parser("render", help="render a trajectory file to .mp4/.gif/.png (CPU: pyrender+EGL; GPU: SAPIEN)")
     s.add_argument("trajectory")
@@ -636,6 +645,8 @@ def main(argv=None) -> int:
     s.add_argument("--hand", default="allegro")
     s.add_argument("--seed", type=int, default=0)
     s.add_argument("--video", default=None, help="record the first trial and render it to this .mp4")
+    s.add_argument("--sim", action="append", metavar="KEY=VALUE",
+                   help="physics other than configs/task.yaml's sim section (repeatable), as `unicross eval --sim`")
     s.add_argument("--out", default=None, help="JSON with every trial")
     s.set_defaults(fn=_cmd_chain)
     s = sub.add_parser("export", help="ship a run: policy weights + normaliser only, with a JSON sidecar")

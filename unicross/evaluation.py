@@ -487,13 +487,13 @@ def markdown_table(rows: Dict[str, Dict[str, dict]]) -> str:
 # ----------------------------------------------------------------------------- long horizon
 def run_chain(policy: PolicyFn, objects: Sequence[ObjectSpec], sequence: Optional[str] = None,
               hand: str = "allegro", trials_per_object: int = EVAL_CFG["trials_per_object"], seed: int = 0, randomize: bool = False,
-              progress: bool = True, videos: int = 0, video_dir=None) -> List[dict]:
+              progress: bool = True, videos: int = 0, video_dir=None, sim: Optional[dict] = None) -> List[dict]:
     """Long-horizon protocol: grasp -> relocate -> in-hand from random table poses in one episode.
 
     ``sequence`` None: the paper's protocol (wrappable objects: rotate about a random axis;
     elongated: translate along a random direction); otherwise e.g. 'grasp,relocate,rotate:x+', run
     on the objects that can do every phase (the others are left out; none raises before any
-    simulation)."""
+    simulation). ``sim``: physics other than ``configs/task.yaml``'s ``sim`` section, as :func:`run_protocol`."""
     from unicross.tasks.chain import objects_for_chain, parse_sequence
     if sequence is not None:
         objects = objects_for_chain(objects, parse_sequence(sequence))
@@ -510,7 +510,8 @@ def run_chain(policy: PolicyFn, objects: Sequence[ObjectSpec], sequence: Optiona
                 seq = sequence
             modes = parse_sequence(seq)
             env = gym.make("UniCross-Chain-v1", obs_mode="state_dict", sim_backend="physx_cpu", render_backend="none",
-                           hand=hand, objects=[obj], randomize=randomize, sequence=modes)
+                           hand=hand, objects=[obj], randomize=randomize, sequence=modes,
+                           config=dict(sim=dict(sim)) if sim else None)
             u = env.unwrapped
             seed_k = trial_seed(seed, oi, k)
             obs, info = u.reset(seed=seed_k)

@@ -158,8 +158,9 @@ class PaperReport:
     markdown."""
 
     def __init__(self, hand: str = "allegro", limit: Optional[int] = 10, trials: int = 3, workers: int = 1,
-                 seed: int = 0, min_trials: int = 100, log: Callable[[str], None] = print):
+                 seed: int = 0, min_trials: int = 100, sim: Optional[dict] = None, log: Callable[[str], None] = print):
         self.hand, self.limit, self.trials, self.workers, self.seed, self.log = hand, limit, trials, workers, seed, log
+        self.sim = sim  # physics other than configs/task.yaml's for every cell (None: each policy's own)
         self.min_trials = min_trials
         self.ckpts = shipped(hand)
         from unicross.gaits import shipped_gaits
@@ -187,7 +188,8 @@ class PaperReport:
             objs, _ = E.protocol_objects(sk.name, get_object_set(objects, limit=self.limit), self.hand)
             trials = E.run_protocol_workers(sk.name, spec, objs, hand=self.hand, workers=self.workers, seed=self.seed,
                                             trials_per_object=self.trials_per_object(len(objs)),
-                                            disturb=disturb, axes=[axis] if axis else None, progress=False)
+                                            disturb=disturb, axes=[axis] if axis else None, progress=False,
+                                            sim=self.sim)
         except ValueError as e:  # e.g. no grasp states for these objects
             return f"not run: {e}"
         self.log(f"  {spec} {mode} on {objects}{' --disturb' if disturb else ''}: {time.time() - t0:.0f} s")
@@ -225,7 +227,11 @@ class PaperReport:
                  + ("." if self.hand == "allegro" else
                     f"; for {self.hand} its row of the paper's hands table (one unified policy, test objects) "
                     "beside the experts and the student, and -- elsewhere (the paper's other settings are "
-                    "Allegro's)."), ""]
+                    "Allegro's).")]
+        if self.sim:
+            lines[-1] += (" Physics: configs/task.yaml's sim section with " +
+                          ", ".join(f"{k}={v}" for k, v in self.sim.items()) + " in every cell.")
+        lines.append("")
         self.log("experts on test objects ...")
         lines += self._table("Experts, held-out test objects", self._per_mode("test", False, "expert"), "Experts")
         lines += self._experts_pooled("test", False, "Experts")
@@ -362,7 +368,7 @@ class PaperReport:
         # the paper's sequences split the objects: wrappable ones rotate, elongated ones translate
         per_sequence = min(sum(o.category == c for o in objs) for c in {o.category for o in objs})
         trials = run_chain(policy, objs, hand=self.hand, trials_per_object=self.trials_per_object(per_sequence),
-                           seed=self.seed, progress=False)
+                           seed=self.seed, progress=False, sim=self.sim)
         chains, by_mode = summarize_chain(trials), chain_last_phase_by_mode(trials)
         self.chain_summaries[name] = dict(summary=chains, in_hand_phase_by_mode=by_mode)
         by_mode_text = "; ".join(f"{m} {sr_cell(v)}" for m, v in by_mode.items())
