@@ -162,7 +162,7 @@ def main(argv=None) -> int:
     ap.add_argument("--heldout-objects", default="test")
     ap.add_argument("--sim", action="append", metavar="KEY=VALUE",
                     help="physics other than configs/task.yaml's sim section (repeatable), e.g. "
-                         "solver_position_iterations=12; recorded in the checkpoint, whose evaluation then runs under it")
+                         "solver_position_iterations=8 (the default before 2026-12-04); recorded in the checkpoint, whose evaluation then runs under it")
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--out", required=True)

@@ -293,7 +293,7 @@ def main():
     ap.add_argument("--lookahead", type=float, default=1.5, help="--tracking phase: control steps ahead on the cycle")
     ap.add_argument("--sim", action="append", metavar="KEY=VALUE",
                     help="physics other than configs/task.yaml's sim section (repeatable), e.g. "
-                         "solver_position_iterations=12; logged in the rows' meta, which the gait then runs under")
+                         "solver_position_iterations=8 (the default before 2026-12-04); logged in the rows' meta, which the gait then runs under")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--out", default=None)
     ap.add_argument("--summary", nargs="+", default=None)

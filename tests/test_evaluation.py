@@ -220,12 +220,12 @@ def test_a_residual_checkpoint_acts_on_top_of_its_gait_and_is_refused_as_a_dagge
         Teachers({"rotate_y-": tmp_path / "rotate_y-" / "checkpoint.pt"}, "cpu")
 
 
-def test_eval_sim_overrides_are_checked_applied_and_recorded(tmp_path, capsys, grasp_file):
+def test_eval_sim_overrides_are_checked_applied_and_recorded(tmp_path, capsys, grasp_file, monkeypatch):
     """``--sim KEY=VALUE`` builds every env of the evaluation with other physics than configs/task.yaml's,
     refuses unknown keys and impossible values before simulating, and is recorded in the result."""
     from unicross.config import parse_sim_overrides
-    assert parse_sim_overrides(["solver_position_iterations=12", "contact_offset=0.01"]) == \
-        dict(solver_position_iterations=12, contact_offset=0.01)
+    assert parse_sim_overrides(["solver_position_iterations=8", "contact_offset=0.01"]) == \
+        dict(solver_position_iterations=8, contact_offset=0.01)
     assert parse_sim_overrides(None) == {}
     for bad, msg in (("solver_iterations=12", "KEY one of"), ("solver_position_iterations", "KEY one of"),
                      ("solver_position_iterations=1.5", "an integer"), ("solver_position_iterations=0", ">= 1"),
@@ -238,19 +238,31 @@ def test_eval_sim_overrides_are_checked_applied_and_recorded(tmp_path, capsys, g
     assert "KEY one of" in capsys.readouterr().err and not out.exists()
     obj = get_object_set("train-elongated", limit=1)[0]
     env = E._env_for("translate", "z+", obj, "allegro", disturb=False, randomize=False, grasp_dataset=str(grasp_file),
-                     original=False, sim=dict(solver_position_iterations=12))
+                     original=False, sim=dict(solver_position_iterations=8))
     u = env.unwrapped
-    assert u.cfg["sim"]["solver_position_iterations"] == 12
-    assert u.sim_config.scene_config.solver_position_iterations == 12
-    assert u.agent.robot._objs[0].get_solver_position_iterations() == 12  # PhysX's own setting of the hand
+    assert u.cfg["sim"]["solver_position_iterations"] == 8
+    assert u.sim_config.scene_config.solver_position_iterations == 8
+    assert u.agent.robot._objs[0].get_solver_position_iterations() == 8  # PhysX's own setting of the hand
     env.close()
     args = ["eval", "--policy", "zero", "--protocol", "translate", "--objects", "train", "--limit", "1",
             "--trials-per-object", "1", "--axis", "z+", "--grasps", str(grasp_file), "--seed", "1"]
-    assert cli(args + ["--sim", "solver_position_iterations=12", "--out", str(out)]) == 0
+    assert cli(args + ["--sim", "solver_position_iterations=8", "--out", str(out)]) == 0
     r = json.loads(out.read_text())
-    assert r["sim"] == dict(solver_position_iterations=12)
+    assert r["sim"] == dict(solver_position_iterations=8)
     assert cli(args + ["--out", str(tmp_path / "d.json")]) == 0
     assert "sim" not in json.loads((tmp_path / "d.json").read_text())  # recorded only where it differs
+    # the long horizon too: refused before simulating, then passed to the chain's env
+    assert cli(["chain", "--policy", "zero", "--sim", "solver_iterations=3"]) == 2
+    assert "KEY one of" in capsys.readouterr().err
+
+    class Built(Exception):
+        pass
+
+    def make(env_id, **kw):
+        raise Built(kw.get("config"))
+    monkeypatch.setattr(E.gym, "make", make)
+    with pytest.raises(Built, match="'solver_position_iterations': 8"):
+        E.run_chain(lambda obs, u: None, [obj], progress=False, sim=dict(solver_position_iterations=8))
 
 
 def test_a_checkpoint_made_under_other_physics_is_evaluated_under_its_own(tmp_path, monkeypatch):
@@ -263,24 +275,24 @@ def test_a_checkpoint_made_under_other_physics_is_evaluated_under_its_own(tmp_pa
     spec = load_hand("allegro")
     dims = dict(hand=2 * spec.dof, object=5 * len(spec.contact_links), goal=F.GOAL_DIM)
     policy, _, _ = make_models(dims, spec.dof, None, load_config("ppo")["model"])
-    path = tmp_path / "it12.pt"
+    path = tmp_path / "it8.pt"
     torch.save(dict(policy=policy.state_dict(), obs_dims=dims, n_act=spec.dof, hand="allegro", config=load_config("ppo"),
-                    skill="translate", axis="z+", env_kwargs=dict(config=dict(sim=dict(solver_position_iterations=12)))),
+                    skill="translate", axis="z+", env_kwargs=dict(config=dict(sim=dict(solver_position_iterations=8)))),
                path)
-    assert E.resolve_policy(str(path), "allegro")[1]["sim"] == dict(solver_position_iterations=12)
+    assert E.resolve_policy(str(path), "allegro")[1]["sim"] == dict(solver_position_iterations=8)
     seen = []
     monkeypatch.setattr(E, "run_protocol", lambda *a, **kw: seen.append(kw.get("sim")) or [])
     objs = get_object_set("train-elongated", limit=1)
     E.run_protocol_workers("translate", str(path), objs, workers=1)
     E.run_protocol_workers("translate", str(path), objs, workers=1, sim=dict(solver_position_iterations=16))
     E.run_protocol_workers("translate", "zero", objs, workers=1)
-    assert seen == [dict(solver_position_iterations=12), dict(solver_position_iterations=16), None]
+    assert seen == [dict(solver_position_iterations=8), dict(solver_position_iterations=16), None]
     # so does a gait searched under other physics (gait_search.py --sim, logged in its rows' meta)
     shipped = json.loads((Path(__file__).parents[1] / "unicross/checkpoints/allegro/gaits/rotate_z+.json").read_text())
     log = tmp_path / "gait.jsonl"
-    log.write_text(json.dumps(dict(meta=dict(shipped["meta"], sim=["solver_position_iterations=12"]), p=shipped["p"],
+    log.write_text(json.dumps(dict(meta=dict(shipped["meta"], sim=["solver_position_iterations=8"]), p=shipped["p"],
                                    score=1.0)) + "\n")
-    assert E.resolve_policy(f"gait:{log}", "allegro")[1]["sim"] == dict(solver_position_iterations=12)
+    assert E.resolve_policy(f"gait:{log}", "allegro")[1]["sim"] == dict(solver_position_iterations=8)
     assert "sim" not in E.resolve_policy("gait:allegro/rotate_z+", "allegro")[1]
 
 
@@ -303,9 +315,9 @@ def test_experts_made_under_other_physics_run_under_it_and_mixed_physics_is_refu
             torch.save(dict(policy=state, obs_dims=dims, n_act=spec.dof, hand="allegro", config=load_config("ppo"),
                             skill=skill, axis=axis or None, env_kwargs=dict(config=dict(sim=sims(m)))),
                        tmp_path / m / "checkpoint.pt")
-    write(lambda m: dict(solver_position_iterations=12))
-    assert E.resolve_policy(f"experts:{tmp_path}", "allegro")[1]["sim"] == dict(solver_position_iterations=12)
-    write(lambda m: dict(solver_position_iterations=12) if m != "grasp" else {})
+    write(lambda m: dict(solver_position_iterations=8))
+    assert E.resolve_policy(f"experts:{tmp_path}", "allegro")[1]["sim"] == dict(solver_position_iterations=8)
+    write(lambda m: dict(solver_position_iterations=8) if m != "grasp" else {})
     with pytest.raises(ValueError, match="different physics"):
         E.resolve_policy(f"experts:{tmp_path}", "allegro")
     assert "sim" not in E.resolve_policy("experts:allegro", "allegro")[1]

@@ -133,7 +133,7 @@ def load_config(name: str, overrides: Optional[Mapping[str, Any]] = None) -> dic
 
 def parse_sim_overrides(pairs) -> dict:
     """``KEY=VALUE`` strings -> overrides of ``configs/task.yaml``'s ``sim`` section (the physics every
-    env of a run is built with, e.g. ``solver_position_iterations=12``). Each key must be one of that
+    env of a run is built with, e.g. ``solver_position_iterations=8``). Each key must be one of that
     section's and each value a number of its type; ranges are checked as the task checks them."""
     sim = load_config("task")["sim"]
     out = {}
