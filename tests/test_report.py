@@ -124,6 +124,23 @@ def test_report_sim_reaches_every_cell_and_chain_and_is_printed(tmp_path, monkey
     assert kinds == {"cell", "chain"} and all(sim == dict(solver_position_iterations=8) for _, sim in seen)
 
 
+def test_report_long_horizon_runs_a_policy_under_its_own_physics_unless_sim_is_given(monkeypatch):
+    """Without ``--sim`` the report's long horizon runs a policy made under other physics under its own, as
+    its cells do (``run_protocol_workers``); with ``--sim`` under that."""
+    from unicross import evaluation as E
+    from unicross.report import PaperReport
+    seen = []
+    monkeypatch.setattr(E, "run_chain", lambda *a, **kw: seen.append(kw.get("sim")) or [])
+    monkeypatch.setattr(E, "summarize_chain", lambda *a, **kw: {})
+    monkeypatch.setattr(E, "chain_table", lambda *a, **kw: "")
+    monkeypatch.setattr(E, "chain_last_phase_by_mode", lambda *a, **kw: {})
+    own = dict(sim=dict(solver_position_iterations=8))
+    PaperReport(limit=1).chain("x", E.zero_policy, own)
+    PaperReport(limit=1).chain("x", E.zero_policy)
+    PaperReport(limit=1, sim=dict(solver_position_iterations=16)).chain("x", E.zero_policy, own)
+    assert seen == [dict(solver_position_iterations=8), None, dict(solver_position_iterations=16)]
+
+
 def test_paper_values_format():
     from unicross.report import _paper
     assert _paper("Ours", "relocate") == "99.0 / 0.54 / 0.0134"

@@ -348,7 +348,7 @@ class PaperReport:
         missing = [m for m in F.MODES if m not in self.student_modes]
         note = ([f"The student was distilled for {', '.join(self.student_modes)} only (not for "
                  f"{', '.join(missing)}): phases of those modes are not expected to succeed.", ""] if missing else [])
-        lines = note + self.chain("student", resolve_policy(self.ckpts["student"], self.hand)[0])
+        lines = note + self.chain("student", *resolve_policy(self.ckpts["student"], self.hand))
         lines += [f"The experts, each phase acted on by its mode's shipped expert (`unicross chain --policy "
                   f"experts:{self.hand}`), on the same trials: what the student's teachers do chained.", ""]
         no_expert = [m for m in F.MODES if m not in self.ckpts]
@@ -356,19 +356,20 @@ class PaperReport:
             lines += [f"Not run: no shipped expert for {', '.join(no_expert)}.", ""]
         else:
             self.log("long horizon, the experts ...")
-            lines += self.chain("experts", make_experts_policy(self.hand, self.hand, self.seed)[0])
+            lines += self.chain("experts", *make_experts_policy(self.hand, self.hand, self.seed))
         return lines + ["Paper (its student): " + "; ".join(f"{k} {' / '.join(f'{x:g}' for x in v)}"
                                                             for k, v in PAPER["long"].items()), ""]
 
-    def chain(self, name: str, policy) -> List[str]:
+    def chain(self, name: str, policy, desc: Optional[dict] = None) -> List[str]:
         """The paper's long-horizon protocol with ``policy``: per-phase table and the in-hand phase by mode
-        (the summaries kept in ``chain_summaries[name]``)."""
+        (the summaries kept in ``chain_summaries[name]``). It runs under the report's ``sim``, else under the
+        physics the policy was made under (its description ``desc``'s ``sim``), as the report's cells."""
         from unicross.evaluation import chain_last_phase_by_mode, chain_table, run_chain, summarize_chain, sr_cell
         objs = get_object_set("test", limit=self.limit)
         # the paper's sequences split the objects: wrappable ones rotate, elongated ones translate
         per_sequence = min(sum(o.category == c for o in objs) for c in {o.category for o in objs})
         trials = run_chain(policy, objs, hand=self.hand, trials_per_object=self.trials_per_object(per_sequence),
-                           seed=self.seed, progress=False, sim=self.sim)
+                           seed=self.seed, progress=False, sim=self.sim or (desc or {}).get("sim"))
         chains, by_mode = summarize_chain(trials), chain_last_phase_by_mode(trials)
         self.chain_summaries[name] = dict(summary=chains, in_hand_phase_by_mode=by_mode)
         by_mode_text = "; ".join(f"{m} {sr_cell(v)}" for m, v in by_mode.items())
