@@ -364,12 +364,13 @@ class PaperReport:
         """The paper's long-horizon protocol with ``policy``: per-phase table and the in-hand phase by mode
         (the summaries kept in ``chain_summaries[name]``). It runs under the report's ``sim``, else under the
         physics the policy was made under (its description ``desc``'s ``sim``), as the report's cells."""
-        from unicross.evaluation import chain_last_phase_by_mode, chain_table, run_chain, summarize_chain, sr_cell
+        from unicross.evaluation import (_own_physics, chain_last_phase_by_mode, chain_table, run_chain,
+                                         summarize_chain, sr_cell)
         objs = get_object_set("test", limit=self.limit)
         # the paper's sequences split the objects: wrappable ones rotate, elongated ones translate
         per_sequence = min(sum(o.category == c for o in objs) for c in {o.category for o in objs})
         trials = run_chain(policy, objs, hand=self.hand, trials_per_object=self.trials_per_object(per_sequence),
-                           seed=self.seed, progress=False, sim=self.sim or (desc or {}).get("sim"))
+                           seed=self.seed, progress=False, **_own_physics(dict(sim=self.sim), desc or {}))
         chains, by_mode = summarize_chain(trials), chain_last_phase_by_mode(trials)
         self.chain_summaries[name] = dict(summary=chains, in_hand_phase_by_mode=by_mode)
         by_mode_text = "; ".join(f"{m} {sr_cell(v)}" for m, v in by_mode.items())
