@@ -32,18 +32,20 @@ def test_shards_together_give_the_unsharded_trials(grasp_file, tiny_objects):
     assert len(whole) == 4 and json.dumps(parts) == json.dumps(whole)
 
 
-def test_reference_policy_slides_the_object_out_and_is_refused_without_a_reference(grasp_file, tiny_objects, tmp_path):
+def test_reference_policy_slides_the_object_out_and_is_refused_without_a_reference(tiny_objects, tmp_path):
     """``--policy reference``: translate's physical references (z+: opening the fingers; z-: curling
     the index finger's distal joints) translate the object along their direction where the zero
     action does not; a mode without a reference is refused before any simulation."""
-    # z-: from the default grasp states (the grasp expert's); from the scripted synthesiser's the index
-    # does not reach the object this way (measured: -0.01 cm vs +5.1 cm from the default ones)
-    for axis, fraction, margin, grasps in (("z+", "0.75", 2.0, grasp_file), ("z-", "1", 2.0, None)):
-        kw = dict(grasp_dataset=grasps, trials_per_object=2, seed=0, progress=False, axes=[axis])
+    # From the default grasp states (the grasp expert's, a shipped file). The scripted synthesiser's
+    # (the grasp_file fixture) are made anew on each machine and differ between machines: from its
+    # grasps the index does not reach the object for z- (-0.01 cm vs +5.1 cm), and on one VM
+    # (2026-12-04) the opening dropped its elongated box in 2 of 2 trials (z+ -6.9 cm vs -0.3).
+    for axis, fraction, margin in (("z+", "0.75", 2.0), ("z-", "1", 2.0)):
+        kw = dict(trials_per_object=2, seed=0, progress=False, axes=[axis])
         ref = E.summarize("translate", E.run_protocol("translate", E.resolve_policy(f"reference@{fraction}", "allegro")[0],
                                                       tiny_objects, **kw))
         zero = E.summarize("translate", E.run_protocol("translate", E.zero_policy, tiny_objects, **kw))
-        assert ref["trans_cm"] > zero["trans_cm"] + margin, (axis, ref, zero)  # measured: z+ +2.9 vs +0.02, z- +5.1 vs ~0 cm
+        assert ref["trans_cm"] > zero["trans_cm"] + margin, (axis, ref, zero)  # measured: z+ +6.4 vs +0.03, z- +5.1 vs ~0 cm
     assert cli(["eval", "--policy", "reference", "--protocol", "rotate", "--objects", "test", "--limit", "1",
                 "--out", str(tmp_path / "e.json")]) == 2  # rotation has none
     assert not (tmp_path / "e.json").exists()

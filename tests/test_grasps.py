@@ -23,10 +23,12 @@ def test_scripted_grasps_hold_for_two_seconds():
     # the dataset describes physically settled grasps: fingers at rest near their PD targets, except
     # those pressed against the object, which sit short of their closing target (by how much depends on
     # where the object lies in the hand, i.e. on the task generator's draws: 0.3-0.9 rad seen); no
-    # joint is pushed past its target, which a stored command or an unsettled pose would show
+    # joint is pushed far past its target, which a stored command or an unsettled pose would show. The
+    # object does push a side joint back a little: up to 0.20 rad seen on the thumb's rotation and 0.16 on
+    # an abduction joint (2026-12-04, one VM, eager step math; 0.16 compiled on the same VM), so the bound is 0.3
     signed = gs.data["finger_qpos"] - gs.data["finger_target"]
     assert signed.abs().mean() < 0.2
-    assert signed.max() < 0.2, "a finger sits beyond its closing target"
+    assert signed.max() < 0.3, "a finger sits beyond its closing target"
     pressed = signed < -0.2
     assert (gs.data["finger_target"][pressed] > 0.5).all(), "a large gap on a joint that is not closing"
 
