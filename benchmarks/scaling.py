@@ -16,7 +16,8 @@ collect_efficiency:  the same for the collection alone (frames over the iteratio
              alone, before the update.
 
 ``--compare-overlap``: each worker count twice, collection then update (the default) and with
-``collector.overlap`` (the workers collect the next batch during the update), in the same run.
+``collector.overlap`` (the workers collect the next batch during the update), in the same run; one
+worker (in-process collection) without overlap only.
 
 Writes JSON (``--json``) and a PNG curve (``--png``). ``--set section.key=value`` overrides
 ``configs/ppo.yaml`` as ``unicross train --set`` does (e.g. the in-hand experts' 4096-frame batches
@@ -95,17 +96,16 @@ def main():
     p.add_argument("--env-steps", type=int, default=1500)
     p.add_argument("--set", action="append", metavar="SECTION.KEY=VALUE", help="override configs/ppo.yaml")
     p.add_argument("--compare-overlap", action="store_true",
-                   help="each worker count without and with collector.overlap (needs >= 2 workers)")
+                   help="each worker count without and with collector.overlap (1 worker: without only; "
+                        "overlapped collection runs in worker processes)")
     p.add_argument("--json", default=None)
     p.add_argument("--png", default=None)
     args = p.parse_args()
-    if args.compare_overlap and min(args.workers) < 2:
-        p.error("--compare-overlap needs >= 2 workers (overlapped collection runs in worker processes)")
     overrides = parse_sets(args.set)
     single_before = single_env_rate(args.env_steps)
     rows = []
     for w in args.workers:
-        for overlap in ((False, True) if args.compare_overlap else (None,)):
+        for overlap in (((False, True) if w >= 2 else (False,)) if args.compare_overlap else (None,)):
             ov = overrides if overlap is None else deep_merge(overrides, {"collector": {"overlap": overlap}},
                                                              strict=False)
             r = training_rate(w, args.iterations, ov)

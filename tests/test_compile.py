@@ -380,3 +380,22 @@ def test_instruction_set_probes_run_once_per_machine(monkeypatch, tmp_path):
             assert not c.settle_vec_isa() and ic.cpp.vec_isa_ok is None
     finally:
         c.settle_vec_isa.cache_clear()
+
+
+@pytest.mark.skipif(__import__("platform").machine() not in ("x86_64", "AMD64"), reason="x86 probes")
+def test_instruction_set_builds_are_remembered_per_machine(monkeypatch, tmp_path):
+    """The sets' extra probes (``VecISA.check_build``: a test library built and loaded in a child
+    Python) run once per machine: a success leaves a marker that a later call answers from, for the
+    same set, flags and code only; a failure leaves none."""
+    import unicross.compiling as c
+    from torch._inductor import cpu_vec_isa as isa
+    calls = []
+    monkeypatch.setattr(isa.VecISA, "check_build", lambda self, code: calls.append(code) or "fail" not in code)
+    c._remember_probe_builds(isa, tmp_path, ["torch", "python", "g++"])
+    avx2, code = isa.VecAVX2(), isa.VecISA._avx_code
+    assert avx2.check_build(code) and len(calls) == 1 and len(list(tmp_path.glob("unicross_isa_build_*.ok"))) == 1
+    assert avx2.check_build(code) and len(calls) == 1  # remembered
+    assert isa.VecAVX512().check_build(code) and len(calls) == 2  # another set's flags: probed
+    assert not avx2.check_build(code + "fail") and not avx2.check_build(code + "fail") and len(calls) == 4
+    c._remember_probe_builds(isa, tmp_path, ["torch", "python", "g++"])  # installed once
+    assert avx2.check_build(code) and len(calls) == 4

@@ -80,10 +80,12 @@ def settle_vec_isa() -> bool:
     passed sets ``torch._inductor.config.cpp.vec_isa_ok`` (the probes' own switch), which answers the
     base probe of each set without building anything. So does the first process once it has probed,
     so that all compile under one configuration (Inductor's cache keys include it). The sets' extra
-    probes (AVX-512 VNNI and bf16, AMX) do not read the switch and still run: measured, a fresh
-    process's probes 1.5 -> 0.35 s on the 2-core VM (torch 2.13), 10 -> 6 child processes (89-102 ->
-    61 s to the first step, one run each) on a lent machine. Nothing changes where a probe failed,
-    where ``vec_isa_ok`` or ``TORCHINDUCTOR_VEC_ISA_OK`` is already set, or off x86."""
+    probes (AVX-512 VNNI and bf16, AMX) do not read the switch: :func:`_remember_probe_builds`
+    answers those from the successes an earlier process recorded (also where ``vec_isa_ok`` is set).
+    Measured with the switch alone: a fresh process's probes 1.5 -> 0.35 s on the 2-core VM (torch
+    2.13), 10 -> 6 child processes (89-102 -> 61 s to the first step, one run each) on a lent
+    machine. Nothing changes where a probe failed, where ``vec_isa_ok`` or
+    ``TORCHINDUCTOR_VEC_ISA_OK`` is already set (beyond the remembered builds), or off x86."""
     import hashlib
     import json
     import platform
@@ -91,12 +93,15 @@ def settle_vec_isa() -> bool:
     try:
         from torch._inductor import config as ic
         from torch._inductor import cpu_vec_isa as isa
-        if ic.cpp.vec_isa_ok is not None or platform.machine() not in ("x86_64", "AMD64"):
+        if platform.machine() not in ("x86_64", "AMD64"):
+            return False
+        root = _records_dir()
+        _remember_probe_builds(isa, root, [torch.__version__, sys.executable, str(ic.cpp.cxx)])
+        if ic.cpp.vec_isa_ok is not None:
             return False
         flags = isa.x86_isa_checker()
         claimed = [str(v) for v in isa.supported_vec_isa_list if all(f in flags for f in str(v).split())]
         key = hashlib.sha256(json.dumps([torch.__version__, sys.executable, str(ic.cpp.cxx), claimed]).encode())
-        root = _records_dir()
         record = root / f"unicross_vec_isa_{key.hexdigest()[:16]}.json"
         try:
             passed = json.loads(record.read_text())["passed"]
@@ -110,6 +115,36 @@ def settle_vec_isa() -> bool:
         return False
     ic.cpp.vec_isa_ok = True
     return True
+
+
+def _remember_probe_builds(isa, root, machine: list) -> None:
+    """Makes ``VecISA.check_build`` (Inductor's build-and-load probe of one instruction set's code)
+    remember its successes per machine: a marker file in ``root`` per (``machine``, set, compiler
+    flags, probe code), written after a probe passed; a later process that finds the marker answers
+    True without building or starting a child. This covers the sets' extra probes that
+    ``cpp.vec_isa_ok`` does not answer (AVX-512 VNNI and bf16, AMX, AMX-fp16; six child processes,
+    ~50 s, in a warm worker's start on the lent machines with torch 2.11: docs/runs/device16_render).
+    A failed probe is not remembered (it may have been a timeout), so it runs again in each process.
+    Installed once per process, on the class, for every set."""
+    import hashlib
+    import json
+    from unicross.config import atomic_write
+    original = isa.VecISA.check_build
+    if getattr(original, "_unicross_remembers", False):
+        return
+
+    def check_build(self, code: str) -> bool:
+        key = json.dumps(machine + [type(self).__name__, self.build_arch_flags(), code])
+        mark = root / f"unicross_isa_build_{hashlib.sha256(key.encode()).hexdigest()[:16]}.ok"
+        if mark.is_file():
+            return True
+        ok = original(self, code)
+        if ok:
+            atomic_write(mark, lambda tmp: tmp.write_text(key))
+        return ok
+
+    check_build._unicross_remembers = True
+    isa.VecISA.check_build = check_build
 
 
 def _fall_back(e: Exception) -> None:
