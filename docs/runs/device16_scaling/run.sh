@@ -5,6 +5,9 @@
 #      start that took 61 s there with the base probes remembered and the sets' extra probes not;
 #   2. benchmarks/scaling.py --workers 1 2 4 8 16 --compare-overlap (compiled step math, default batch,
 #      the real PPO update): training frames/s against workers x one env alone, JSON + PNG.
+#   bash .../run.sh 2 (second call, a fresh machine): the scaling rows again with more iterations at 2
+#   workers (--iterations 12), then 16 workers with 4096-frame batches (the in-hand experts' batch), with
+#   and without overlap; the script's one-env rate comes from the same run.
 # From the repository root, with the wheel bundle of ../shared/tools/device-wheels.sh in .whl and the
 # scripts in .devrun (first_call.py): run with carry [".whl", ".devrun"], timeout_s 560.
 set -u
@@ -27,6 +30,16 @@ first_call() {  # tag timeout
   el "  rc=$? $(grep -o '"make_and_reset_s": [0-9.]*\|"first_step_s": [0-9.]*' "$OUT/first_call_$1.json" | tr '\n' ' ')"
   ls "$TORCHINDUCTOR_CACHE_DIR" | grep -c unicross_isa_build >> "$OUT/log.txt"
 }
+if [ "${1:-1}" = 2 ]; then
+  el "scaling, 2 workers, 12 iterations"
+  timeout 170 python3 scaling.py --workers 2 --compare-overlap --iterations 12 --env-steps 1000 \
+    --json "$OUT/scaling16_w2.json" > "$OUT/scaling_w2.log" 2> "$OUT/scaling_w2.err"
+  el "  rc=$?"
+  el "scaling, 16 workers, 4096-frame batches"
+  timeout 110 python3 scaling.py --workers 16 --compare-overlap --iterations 4 --env-steps 1000 \
+    --set collector.frames_per_batch=4096 --json "$OUT/scaling16_w16_4096.json" > "$OUT/scaling_w16.log" 2> "$OUT/scaling_w16.err"
+  el "  rc=$?"; el done; exit 0
+fi
 first_call cold 200
 first_call warm 90
 el "scaling"
