@@ -19,8 +19,8 @@ collect_efficiency:  the same for the collection alone (frames over the iteratio
 ``collector.overlap`` (the workers collect the next batch during the update), in the same run; one
 worker (in-process collection) without overlap only.
 
-Writes JSON (``--json``) and a PNG curve (``--png``). ``--set section.key=value`` overrides
-``configs/ppo.yaml`` as ``unicross train --set`` does (e.g. the in-hand experts' 4096-frame batches
+Writes JSON (``--json``) and a PNG curve (``--png``; ``--from-json`` draws it from an earlier run's
+JSON). ``--set section.key=value`` overrides ``configs/ppo.yaml`` as ``unicross train --set`` does (e.g. the in-hand experts' 4096-frame batches
 and ``optim.kl_stop``), for the training rows only.
 
     python benchmarks/scaling.py [--workers 1 2] [--iterations 4] [--set ...] [--json docs/scaling.json] [--png docs/scaling.png]
@@ -89,6 +89,29 @@ def training_rate(workers: int, iterations: int, overrides: dict | None = None) 
                 minibatch_steps=round(sum(r["minibatch_steps"] for r in rows) / len(rows), 1))
 
 
+def plot(out: dict, path: str) -> None:
+    """The PNG curve of a run's JSON: training frames/s per worker count (with and without overlap
+    where both ran) against workers x one env alone."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    rows, single = out["rows"], out["single_env_steps_per_s"]
+    ws = sorted({r["workers"] for r in rows})
+    fig, ax = plt.subplots(figsize=(5, 3.5))
+    for overlap in sorted({r["overlap"] for r in rows}):
+        sel = [r for r in rows if r["overlap"] == overlap]
+        ax.plot([r["workers"] for r in sel], [r["training_fps"] for r in sel], "o-",
+                label="training (PPO, lean collector" + (", overlapped)" if overlap else ")"))
+    ax.plot(ws, [w * single for w in ws], "--", color="gray", label="workers x single env")
+    ax.set_xticks(ws)
+    ax.set_xlabel("env worker processes")
+    ax.set_ylabel("frames/s")
+    ax.set_title(f"Allegro grasp, {out['cores']} cores")
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+
+
 def main():
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--workers", type=int, nargs="+", default=[1, 2])
@@ -100,7 +123,15 @@ def main():
                         "overlapped collection runs in worker processes)")
     p.add_argument("--json", default=None)
     p.add_argument("--png", default=None)
+    p.add_argument("--from-json", default=None, metavar="JSON",
+                   help="measure nothing: draw --png from an earlier run's JSON (e.g. one from a lent machine)")
     args = p.parse_args()
+    if args.from_json:
+        if not args.png:
+            p.error("--from-json draws a PNG: give --png")
+        with open(args.from_json) as f:
+            plot(json.load(f), args.png)
+        return
     overrides = parse_sets(args.set)
     single_before = single_env_rate(args.env_steps)
     rows = []
@@ -132,23 +163,7 @@ def main():
         with open(args.json, "w") as f:
             json.dump(out, f, indent=1)
     if args.png:
-        import matplotlib
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-        ws = sorted({r["workers"] for r in rows})
-        fig, ax = plt.subplots(figsize=(5, 3.5))
-        for overlap in sorted({r["overlap"] for r in rows}):
-            sel = [r for r in rows if r["overlap"] == overlap]
-            ax.plot([r["workers"] for r in sel], [r["training_fps"] for r in sel], "o-",
-                    label="training (PPO, lean collector" + (", overlapped)" if overlap else ")"))
-        ax.plot(ws, [w * single for w in ws], "--", color="gray", label="workers x single env")
-        ax.set_xticks(ws)
-        ax.set_xlabel("env worker processes")
-        ax.set_ylabel("frames/s")
-        ax.set_title(f"Allegro grasp, {os.cpu_count()} cores")
-        ax.legend()
-        fig.tight_layout()
-        fig.savefig(args.png, dpi=120)
+        plot(out, args.png)
 
 
 if __name__ == "__main__":

@@ -32,11 +32,11 @@ first_call() {  # tag timeout
 }
 if [ "${1:-1}" = 2 ]; then
   el "scaling, 2 workers, 12 iterations"
-  timeout 170 python3 scaling.py --workers 2 --compare-overlap --iterations 12 --env-steps 1000 \
+  timeout 195 python3 scaling.py --workers 2 --compare-overlap --iterations 12 --env-steps 1000 \
     --json "$OUT/scaling16_w2.json" > "$OUT/scaling_w2.log" 2> "$OUT/scaling_w2.err"
   el "  rc=$?"
   el "scaling, 16 workers, 4096-frame batches"
-  timeout 110 python3 scaling.py --workers 16 --compare-overlap --iterations 4 --env-steps 1000 \
+  timeout 125 python3 scaling.py --workers 16 --compare-overlap --iterations 4 --env-steps 1000 \
     --set collector.frames_per_batch=4096 --json "$OUT/scaling16_w16_4096.json" > "$OUT/scaling_w16.log" 2> "$OUT/scaling_w16.err"
   el "  rc=$?"; el done; exit 0
 fi
