@@ -347,3 +347,33 @@ def test_a_rollout_stores_what_stepping_the_env_by_hand_gives():
         assert bool(buf["next", "done"][0, 63, 0])  # the replay crossed an episode boundary
     finally:
         env.close()
+
+
+def test_alternate_envs_run_whole_episodes_and_change_nothing_at_share_zero():
+    """Alternates of a rollout (DAgger's long-horizon chains, ``env.chain_share``): with share 1 every
+    episode after the first env's first one runs in the chain, phase by phase (the goal's mode), and
+    ends where the chain ends; with share 0 the batch is the one without alternates, bit for bit."""
+    from unicross import formulation as F
+    first = dict(KW, num_envs=1, sim_backend="physx_cpu",
+                 config={"terminate_on_drop": False, "episode_length": {"grasp": 5}})
+    chain = ("UniCross-Chain-v1", dict(objects="train-wrappable", object_limit=1, num_envs=1, sim_backend="physx_cpu",
+                                       sequence="grasp,relocate,rotate:z+", config={"terminate_on_drop": False},
+                                       phase_steps={"grasp": 3, "relocate": 3, "rotate": 3}))
+    bufs = {}
+    for name, alternates, share in (("chain", [chain], 1.0), ("zero", [chain], 0.0), ("none", None, 0.0)):
+        ro = C.Rollout("UniCross-Grasp-v1", first, seed=3, alternates=alternates, alternate_share=share)
+        torch.manual_seed(0)
+        policy, _ = _models(ro)
+        ro.set_actor(policy.module[0].module)
+        bufs[name] = C.make_buffer(1, 23, ro.dims, ro.n_act)
+        ro.collect(bufs[name])
+        ro.close()
+    modes = [F.MODES[i] for i in bufs["chain"]["goal"][0, :, :F.NUM_MODES].argmax(-1).tolist()]
+    one_chain = ["grasp"] * 3 + ["relocate"] * 3 + ["rotate_z+"] * 3
+    assert modes == ["grasp"] * 5 + one_chain + one_chain
+    done = bufs["chain"]["next", "done"][0, :, 0].nonzero().flatten().tolist()
+    assert done == [4, 13, 22]
+    assert all(torch.equal(bufs["zero"][k], bufs["none"][k])
+               for k in bufs["none"].keys(include_nested=True, leaves_only=True))
+    with pytest.raises(ValueError, match="CPU env workers"):
+        LeanCollector("UniCross-Grasp-v1", KW, 2, 4, backend="physx_cuda", alternates=[chain], alternate_share=0.5)

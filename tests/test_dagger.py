@@ -199,3 +199,24 @@ def test_dagger_starts_from_a_student_and_learns_around_its_states(tmp_path, exp
         assert not all(torch.equal(v, before[k]) for k, v in t.actor.named_parameters())
     finally:
         t.close()
+
+
+def test_chain_share_adds_one_chain_per_in_hand_mode_on_the_multi_skill_objects():
+    """``env.chain_share``: the chains the student also acts in (grasp, relocate, one in-hand mode each),
+    with the multi-skill env's settings and objects (default the training set); refused without
+    grasp and relocate, or outside [0, 1]; none at 0 (the paper's DAgger)."""
+    from unicross import formulation as F
+    from unicross.rl.dagger import chain_envs
+    kw = dict(randomize=True, modes=list(F.MODES), reconfiguration_freq=2, config=None, hand="allegro",
+              grasp_dataset="x.pt")
+    assert chain_envs(kw, 0.0) == []
+    got = chain_envs(kw, 0.3)
+    assert [k["sequence"][-1] for _, k in got] == [m for m in F.MODES if m.startswith(("rotate", "translate"))]
+    for env_id, k in got:
+        assert env_id == "UniCross-Chain-v1" and k["sequence"][:2] == ["grasp", "relocate"]
+        assert k["objects"] == "train" and "grasp_dataset" not in k and "modes" not in k and k["hand"] == "allegro"
+    assert chain_envs(dict(kw, objects="test"), 1.0)[0][1]["objects"] == "test"
+    with pytest.raises(ValueError, match="grasp, relocate"):
+        chain_envs(dict(kw, modes=["grasp", "rotate_x+"]), 0.5)
+    with pytest.raises(ValueError, match="chain_share"):
+        chain_envs(kw, 1.5)

@@ -109,17 +109,27 @@ class Rollout:
     ``teacher`` (:func:`make_teacher`): its action in every state is written to ``teacher_action``;
     with ``residual`` the env also takes it added to the policy's action (``model.base_policy``:
     :func:`residual_action`; the stored action, its log-probability and PPO's ratio are the
-    network's, the gait being part of the env as PPO sees it)."""
+    network's, the gait being part of the env as PPO sees it).
+
+    ``alternates`` (one env, CPU workers): other envs ``[(env_id, kwargs), ...]`` with the same
+    observation and action sizes, e.g. DAgger's long-horizon chains (``env.chain_share``). At each
+    episode's end the next episode runs in one of them with probability ``alternate_share`` (which one
+    uniformly), else in the first env; each is made at its first episode (a reset seeded with
+    ``seed + 1000 k``) and kept, later episodes continuing its generator. The draws have their own
+    generator, so the first env's episodes and the action noise are as without alternates."""
 
     def __init__(self, env_id: str, env_kwargs: dict, seed: int, deterministic: bool = False,
-                 noise_correlation: float = 0.0, teacher: Optional[str] = None, residual: bool = False):
-        import gymnasium as gym
+                 noise_correlation: float = 0.0, teacher: Optional[str] = None, residual: bool = False,
+                 alternates: Optional[list] = None, alternate_share: float = 0.0):
         import unicross  # noqa: F401  (registers the tasks)
-        kw = dict(render_backend="none", **env_kwargs)
-        kw["obs_mode"] = "state"  # flat: the three groups are views of it (obs_splitter)
-        self._gym = gym.make(env_id, **kw)
-        self.task = self._gym.unwrapped
-        self._split = obs_splitter(self.task._obs_layout)
+        self._seed = seed
+        self._specs = [(env_id, env_kwargs)] + [(i, dict(k)) for i, k in (alternates or [])]
+        self._share = float(alternate_share)
+        self._pick = torch.Generator().manual_seed(seed + 7919)  # which env runs the next episode
+        self._slots: dict = {}
+        self._use(0)
+        if len(self._specs) > 1 and self.task.num_envs != 1:
+            raise ValueError("alternate envs need one env per rollout (CPU env workers)")
         self.actor: Optional[torch.nn.Module] = None
         self.deterministic = deterministic
         self.device = self.task.device
@@ -135,6 +145,41 @@ class Rollout:
         self.obs = self._split(obs)
         self.dims = {k: x.shape[-1] for k, x in zip(OBS_KEYS, self.obs)}
         self.n_act = int(self.task.single_action_space.shape[0])
+
+    def _use(self, k: int) -> bool:
+        """Env ``k`` of ``_specs`` becomes the one stepped (made now if new: True)."""
+        new = k not in self._slots
+        if new:
+            import gymnasium as gym
+            env_id, env_kwargs = self._specs[k]
+            kw = dict(render_backend="none", **env_kwargs)
+            kw["obs_mode"] = "state"  # flat: the three groups are views of it (obs_splitter)
+            env = gym.make(env_id, **kw)
+            self._slots[k] = (env, env.unwrapped, obs_splitter(env.unwrapped._obs_layout))
+        self._gym, self.task, self._split = self._slots[k]
+        return new
+
+    def _reset_done(self, done: torch.Tensor) -> tuple:
+        """Resets the envs that finished (``done`` [N]); their first observations (split). With
+        alternates, the next episode may run in another env (see the class)."""
+        if len(self._specs) == 1:
+            options = {} if self.task.num_envs == 1 else {"env_idx": torch.nonzero(done).flatten()}
+            obs, _ = self.task.reset(options=options)
+            return self._split(obs)
+        k = 0
+        if float(torch.rand((), generator=self._pick)) < self._share:
+            k = 1 + int(torch.randint(len(self._specs) - 1, (), generator=self._pick))
+        if self._use(k):
+            obs, _ = self.task.reset(seed=self._seed + 1000 * k)
+            fresh = self._split(obs)
+            got = {key: x.shape[-1] for key, x in zip(OBS_KEYS, fresh)}
+            if got != self.dims or int(self.task.single_action_space.shape[0]) != self.n_act:
+                raise ValueError(f"alternate env {self._specs[k][0]}: observation sizes {got} and "
+                                 f"{self.task.single_action_space.shape[0]} actions, the first env has {self.dims} "
+                                 f"and {self.n_act}")
+            return fresh
+        obs, _ = self.task.reset()
+        return self._split(obs)
 
     def set_actor(self, actor: torch.nn.Module) -> None:
         self.actor = actor
@@ -168,9 +213,7 @@ class Rollout:
             info_s.append([info[k] for k in info_names])
             done = terminated | truncated
             if bool(done.any()):
-                options = {} if self.task.num_envs == 1 else {"env_idx": torch.nonzero(done).flatten()}
-                obs, _ = self.task.reset(options=options)
-                fresh = self._split(obs)
+                fresh = self._reset_done(done)
                 nxt = fresh if self.task.num_envs == 1 else \
                     tuple(torch.where(done[:, None], f, x) for f, x in zip(fresh, nxt))
                 if self.eps is not None:  # a new episode starts its noise from the stationary law
@@ -204,17 +247,21 @@ class Rollout:
         return self.eps
 
     def close(self):
-        self._gym.close()
+        for env, _, _ in self._slots.values():
+            env.close()
+        self._slots = {}
 
 
 def _worker(rank: int, env_id: str, env_kwargs: dict, seed: int, deterministic: bool, noise_correlation: float,
-            teacher: Optional[str], residual: bool, conn) -> None:
-    """Worker process: one env. Reports its sizes, receives the shared actor and buffer, then
-    fills row ``rank`` of the buffer on every "collect"."""
+            teacher: Optional[str], residual: bool, conn, alternates: Optional[list] = None,
+            alternate_share: float = 0.0) -> None:
+    """Worker process: one env (and its ``alternates``, :class:`Rollout`). Reports its sizes, receives
+    the shared actor and buffer, then fills row ``rank`` of the buffer on every "collect"."""
     torch.set_num_threads(1)
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C reaches the whole group; the main process stops us
     try:
-        rollout = Rollout(env_id, env_kwargs, seed, deterministic, noise_correlation, teacher, residual)
+        rollout = Rollout(env_id, env_kwargs, seed, deterministic, noise_correlation, teacher, residual,
+                          alternates, alternate_share)
         conn.send(("ready", (rollout.dims, rollout.n_act)))
         msg, (actor, buf) = conn.recv()
         rollout.set_actor(actor)
@@ -320,8 +367,14 @@ class LeanCollector:
 
     def __init__(self, env_id: str, env_kwargs: dict, num_envs: int, horizon: int, seed: int = 0,
                  backend: str = "physx_cpu", deterministic: bool = False, noise_correlation: float = 0.0,
-                 teacher: Optional[str] = None, residual: bool = False):
+                 teacher: Optional[str] = None, residual: bool = False, alternates: Optional[list] = None,
+                 alternate_share: float = 0.0):
         self.horizon, self.num_envs, self.teacher = horizon, num_envs, teacher is not None
+        if alternates and backend == "physx_cuda":
+            raise ValueError("alternate envs (e.g. DAgger's env.chain_share) run in CPU env workers, not on the GPU "
+                             "backend")
+        if not 0.0 <= alternate_share <= 1.0:
+            raise ValueError(f"the share of episodes in alternate envs must be in [0, 1], got {alternate_share}")
         kw = dict(env_kwargs)
         self._procs, self._conns, self._local, self.buf = [], [], None, None
         self._learner: Optional[torch.nn.Module] = None  # the actor the workers' copy follows (own_copy)
@@ -332,15 +385,17 @@ class LeanCollector:
             kw.update(sim_backend="physx_cuda", num_envs=num_envs)
         else:
             kw.update(sim_backend="physx_cpu", num_envs=1)
+        alt = [(i, dict(k, sim_backend=kw["sim_backend"], num_envs=kw["num_envs"])) for i, k in alternates or []]
         if backend == "physx_cuda" or num_envs == 1:
-            self._local = Rollout(env_id, kw, seed, deterministic, noise_correlation, teacher, residual)
+            self._local = Rollout(env_id, kw, seed, deterministic, noise_correlation, teacher, residual, alt,
+                                  alternate_share)
             self.dims, self.n_act, self.device = self._local.dims, self._local.n_act, self._local.device
             return
         ctx = mp.get_context("spawn")
         for rank in range(num_envs):
             parent, child = ctx.Pipe()
             p = ctx.Process(target=_worker, args=(rank, env_id, kw, seed + rank, deterministic, noise_correlation, teacher,
-                                                          residual, child), daemon=True,
+                                                          residual, child, alt, alternate_share), daemon=True,
                             name=f"unicross-env-{rank}")
             p.start()
             self._procs.append(p)
@@ -511,15 +566,19 @@ def check_overlap(overlap: bool, backend: str, num_envs: int, ray_address: Optio
 
 def make_collector(env_id: str, env_kwargs: dict, num_envs: int, horizon: int, seed: int, backend: str,
                    ray_address: Optional[str] = None, deterministic: bool = False, noise_correlation: float = 0.0,
-                   teacher: Optional[str] = None, residual: bool = False):
+                   teacher: Optional[str] = None, residual: bool = False, alternates: Optional[list] = None,
+                   alternate_share: float = 0.0):
     """The collector of a trainer: Ray env actors when ``ray_address`` is set (see
-    :func:`resolve_num_envs`, which connects), else :class:`LeanCollector`."""
+    :func:`resolve_num_envs`, which connects), else :class:`LeanCollector` (``alternates``: see
+    :class:`Rollout`)."""
     if not 0.0 <= noise_correlation < 1.0:
         raise ValueError(f"collector.noise_correlation must be in [0, 1), got {noise_correlation}")
+    if ray_address and alternates:
+        raise ValueError("alternate envs (e.g. DAgger's env.chain_share) run in local env workers, not Ray env actors")
     if ray_address:
         from unicross.rl.ray_collector import RayCollector
         return RayCollector(env_id, env_kwargs, num_envs, horizon, seed=seed, address=ray_address,
                             deterministic=deterministic, noise_correlation=noise_correlation)
     return LeanCollector(env_id, env_kwargs, num_envs, horizon, seed=seed, backend=backend,
                          deterministic=deterministic, noise_correlation=noise_correlation, teacher=teacher,
-                         residual=residual)
+                         residual=residual, alternates=alternates, alternate_share=alternate_share)

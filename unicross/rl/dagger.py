@@ -7,6 +7,9 @@ of its mode (query rate 100%); the (observation, expert action) pairs go to a Te
 buffer (``LazyTensorStorage``, capacity 1e6 by default); the student then takes
 ``grad_steps`` MSE steps on sampled batches (once ``optim.warmup_frames`` rows are stored; 0 by default).
 
+``env.chain_share`` (ours, 0 by default): that share of the workers' episodes runs in long-horizon
+chains (grasp, relocate, an in-hand mode; :func:`chain_envs`) instead, labelled phase by phase.
+
 The trainer refuses to start unless every mode of ``env.modes`` (default: all ten) has an expert checkpoint
 (``<experts>/<mode>/checkpoint.pt``, the run directories of ``unicross train``).
 Checkpoints (student, optimiser, epoch, replay buffer, RNG) make runs resumable; per-mode action
@@ -45,6 +48,26 @@ def expert_paths(experts_dir, modes=F.MODES) -> Dict[str, Path]:
                                 f"(expected <experts>/<mode>/checkpoint.pt, e.g. from "
                                 f"`unicross train --skill rotate --axis x+ --out {d}/rotate_x+`)")
     return paths
+
+
+def chain_envs(multi_kwargs: dict, share: float) -> list:
+    """``env.chain_share``: the long-horizon chains the student also acts in, as ``(env_id, kwargs)``
+    alternates of the multi-skill env (:class:`unicross.rl.collector.Rollout`): grasp, relocate, then
+    each rotate or translate mode of the run's modes (the paper's Gr.+Re.+Rot. / Gr.+Re.+Trans. sequences, one per
+    axis), on the multi-skill env's objects (default: the training set) and settings. Empty for a
+    share of 0; refused when the modes lack grasp, relocate or any rotate or translate mode."""
+    if not 0.0 <= share <= 1.0:
+        raise ValueError(f"env.chain_share must be in [0, 1], got {share}")
+    if share == 0.0:
+        return []
+    modes = list(multi_kwargs["modes"])
+    tails = [m for m in modes if R.skill_of_mode(m).accumulates]  # rotate, translate
+    if "grasp" not in modes or "relocate" not in modes or not tails:
+        raise ValueError(f"env.chain_share > 0 needs grasp, relocate and a rotate or translate mode among env.modes, "
+                         f"got {modes}")
+    kw = {k: v for k, v in multi_kwargs.items() if k not in ("modes", "grasp_dataset")}
+    kw.setdefault("objects", "train")
+    return [("UniCross-Chain-v1", dict(kw, sequence=["grasp", "relocate", m])) for m in tails]
 
 
 class Teachers(torch.nn.Module):
@@ -136,8 +159,10 @@ class DAggerTrainer(Runner):
         num_envs = resolve_num_envs(ec["num_envs"], ec["backend"], ray_address)
         self.overlap = bool(cfg["collector"].get("overlap", False))
         check_overlap(self.overlap, ec["backend"], num_envs, ray_address)
+        chains = chain_envs(kw, float(ec.get("chain_share") or 0.0))
         self.collector = make_collector("UniCross-MultiSkill-v1", kw, num_envs, cfg["collector"]["rollout_steps"], seed,
-                                        ec["backend"], ray_address, deterministic=True)
+                                        ec["backend"], ray_address, deterministic=True, alternates=chains,
+                                        alternate_share=float(ec.get("chain_share") or 0.0))
         self.dims, self.n_act = self.collector.dims, self.collector.n_act
         self.student, _, self.norm = make_models(self.dims, self.n_act, Bounded(-1.0, 1.0, (self.n_act,)),
                                                  cfg["model"])
