@@ -156,7 +156,7 @@ class Rollout:
             kw["obs_mode"] = "state"  # flat: the three groups are views of it (obs_splitter)
             env = gym.make(env_id, **kw)
             self._slots[k] = (env, env.unwrapped, obs_splitter(env.unwrapped._obs_layout))
-        self._gym, self.task, self._split = self._slots[k]
+        _, self.task, self._split = self._slots[k]
         return new
 
     def _reset_done(self, done: torch.Tensor) -> tuple:

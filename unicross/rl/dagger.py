@@ -159,10 +159,10 @@ class DAggerTrainer(Runner):
         num_envs = resolve_num_envs(ec["num_envs"], ec["backend"], ray_address)
         self.overlap = bool(cfg["collector"].get("overlap", False))
         check_overlap(self.overlap, ec["backend"], num_envs, ray_address)
-        chains = chain_envs(kw, float(ec.get("chain_share") or 0.0))
+        chain_share = float(ec.get("chain_share") or 0.0)
         self.collector = make_collector("UniCross-MultiSkill-v1", kw, num_envs, cfg["collector"]["rollout_steps"], seed,
-                                        ec["backend"], ray_address, deterministic=True, alternates=chains,
-                                        alternate_share=float(ec.get("chain_share") or 0.0))
+                                        ec["backend"], ray_address, deterministic=True,
+                                        alternates=chain_envs(kw, chain_share), alternate_share=chain_share)
         self.dims, self.n_act = self.collector.dims, self.collector.n_act
         self.student, _, self.norm = make_models(self.dims, self.n_act, Bounded(-1.0, 1.0, (self.n_act,)),
                                                  cfg["model"])
