@@ -17,7 +17,9 @@ collect_efficiency:  the same for the collection alone (frames over the iteratio
 
 ``--compare-overlap``: each worker count twice, collection then update (the default) and with
 ``collector.overlap`` (the workers collect the next batch during the update), in the same run; one
-worker (in-process collection) without overlap only.
+worker (in-process collection) without overlap only. ``--update-devices cpu cuda``: each row once per
+``optim.update_device`` (the learner on the CPU, or on a GPU with the workers acting with a CPU copy),
+in the same run.
 
 Writes JSON (``--json``) and a PNG curve (``--png``; ``--from-json`` draws it from an earlier run's
 JSON). ``--set section.key=value`` overrides ``configs/ppo.yaml`` as ``unicross train --set`` does (e.g. the in-hand experts' 4096-frame batches
@@ -98,10 +100,10 @@ def plot(out: dict, path: str) -> None:
     rows, single = out["rows"], out["single_env_steps_per_s"]
     ws = sorted({r["workers"] for r in rows})
     fig, ax = plt.subplots(figsize=(5, 3.5))
-    for overlap in sorted({r["overlap"] for r in rows}):
-        sel = [r for r in rows if r["overlap"] == overlap]
+    for overlap, dev in sorted({(r["overlap"], r.get("update_device")) for r in rows}, key=str):
+        sel = [r for r in rows if r["overlap"] == overlap and r.get("update_device") == dev]
         ax.plot([r["workers"] for r in sel], [r["training_fps"] for r in sel], "o-",
-                label="training (PPO, lean collector" + (", overlapped)" if overlap else ")"))
+                label="training (PPO" + (f", update on {dev}" if dev else "") + (", overlapped)" if overlap else ")"))
     ax.plot(ws, [w * single for w in ws], "--", color="gray", label="workers x single env")
     ax.set_xticks(ws)
     ax.set_xlabel("env worker processes")
@@ -121,6 +123,8 @@ def main():
     p.add_argument("--compare-overlap", action="store_true",
                    help="each worker count without and with collector.overlap (1 worker: without only; "
                         "overlapped collection runs in worker processes)")
+    p.add_argument("--update-devices", nargs="+", default=None, metavar="DEVICE",
+                   help="each row once per optim.update_device (e.g. cpu cuda), in the same run")
     p.add_argument("--json", default=None)
     p.add_argument("--png", default=None)
     p.add_argument("--from-json", default=None, metavar="JSON",
@@ -139,10 +143,13 @@ def main():
         for overlap in (((False, True) if w >= 2 else (False,)) if args.compare_overlap else (None,)):
             ov = overrides if overlap is None else deep_merge(overrides, {"collector": {"overlap": overlap}},
                                                              strict=False)
-            r = training_rate(w, args.iterations, ov)
-            r["overlap"] = bool(ov.get("collector", {}).get("overlap", False))
-            rows.append(r)
-            print(json.dumps(r), flush=True)
+            for dev in args.update_devices or [None]:
+                od = ov if dev is None else deep_merge(ov, {"optim": {"update_device": dev}}, strict=False)
+                r = training_rate(w, args.iterations, od)
+                r["overlap"] = bool(od.get("collector", {}).get("overlap", False))
+                r["update_device"] = (od.get("optim") or {}).get("update_device")
+                rows.append(r)
+                print(json.dumps(r), flush=True)
     single_after = single_env_rate(args.env_steps, seed=1)
     single = (single_before + single_after) / 2
     lo, hi = sorted((single_before, single_after))

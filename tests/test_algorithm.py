@@ -146,3 +146,28 @@ def test_observation_statistics_freeze_with_a_copied_policy(mode, init_policy, f
     assert same == frozen
     with pytest.raises(ValueError, match="model.obs_stats"):
         PPO(DIMS, A, load_config("ppo", {"model": {"obs_stats": "fixed"}}), frames_per_batch=N * T)
+
+
+@pytest.mark.skipif(not torch.cuda.is_available(), reason="needs a CUDA device (optim.update_device=cuda)")
+def test_update_on_the_gpu_matches_the_cpu():
+    """optim.update_device=cuda: the same batch, the same minibatch order (the sampler draws on the
+    CPU's generator) and the same starting weights give the CPU's update to float rounding."""
+    cpu = make_algo()
+    gpu = PPO(DIMS, A, load_config("ppo"), frames_per_batch=N * T, device="cuda")
+    gpu.policy.load_state_dict(cpu.policy.state_dict())
+    gpu.value.load_state_dict(cpu.value.state_dict())
+    g = torch.Generator().manual_seed(1)
+    for _ in range(3):
+        batch = bandit_batch(cpu, g)
+        torch.manual_seed(7)
+        out_c = cpu.update(batch.clone())
+        torch.manual_seed(7)
+        out_g = gpu.update(batch.clone().to("cuda"))
+        for k in ("loss_objective", "loss_critic", "kl", "value_mean"):
+            assert out_g[k] == pytest.approx(out_c[k], rel=1e-3, abs=1e-5), k
+    obs = [torch.randn(64, DIMS[k], generator=g) for k in OBS_KEYS]
+    with torch.no_grad():
+        loc_c, _ = cpu.actor(*obs)
+        loc_g, _ = gpu.actor(*(o.cuda() for o in obs))
+    assert torch.allclose(loc_g.cpu(), loc_c, atol=1e-3)
+    assert torch.allclose(gpu.norm.hand_mean.cpu(), cpu.norm.hand_mean, atol=1e-5)

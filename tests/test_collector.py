@@ -187,12 +187,47 @@ def test_overlapped_workers_act_with_their_own_copy_until_synced():
         c.close()
     whole = evaluation_shard(actor, shard=None, **kw)
     assert sorted(split, key=lambda t: t["object"]) == sorted(whole, key=lambda t: t["object"])
-    with pytest.raises(ValueError, match="worker processes"):
-        one = LeanCollector("UniCross-Grasp-v1", KW, num_envs=1, horizon=4, seed=0)
-        try:
-            one.set_actor(actor, own_copy=True)
-        finally:
-            one.close()
+    one = LeanCollector("UniCross-Grasp-v1", KW, num_envs=1, horizon=4, seed=0)
+    try:  # one env in the main process (a learner on the GPU): its copy too follows only at sync_actor()
+        one.set_actor(actor, own_copy=True)
+        with torch.no_grad():
+            actor.net.main[-1].bias.add_(0.3)
+        assert not torch.equal(one._shared.net.main[-1].bias, actor.net.main[-1].bias)
+        one.sync_actor()
+        assert torch.equal(one._shared.net.main[-1].bias, actor.net.main[-1].bias)
+    finally:
+        one.close()
+
+
+def test_update_device_is_checked_before_any_simulation(tmp_path):
+    """optim.update_device: null is the envs' device; "auto" the GPU only where torch sees one; a GPU
+    that is not there, or a CPU update of GPU envs, is refused with what to set."""
+    from unicross.rl.collector import resolve_update_device
+    assert resolve_update_device(None, "physx_cpu") == torch.device("cpu")
+    assert resolve_update_device("cpu", "physx_cpu") == torch.device("cpu")
+    assert resolve_update_device("auto", "physx_cpu").type == ("cuda" if torch.cuda.is_available() else "cpu")
+    with pytest.raises(ValueError, match="must be null"):
+        resolve_update_device("tpu", "physx_cpu")
+    with pytest.raises(ValueError, match="must be null"):
+        resolve_update_device("gpu please", "physx_cpu")
+    with pytest.raises(ValueError, match="physx_cuda"):
+        resolve_update_device("cpu", "physx_cuda")
+    if not torch.cuda.is_available():
+        with pytest.raises(ValueError, match="no CUDA device"):
+            resolve_update_device("cuda", "physx_cpu")
+        from unicross.rl.ppo import PPOTrainer
+        with pytest.raises(ValueError, match="no CUDA device"):  # by the trainer, before its env workers start
+            PPOTrainer(tmp_path / "run", "grasp", progress=False, overrides={"optim": {"update_device": "cuda"}})
+
+
+def test_state_on_cpu_keeps_module_metadata():
+    from unicross.rl.runner import on_cpu
+    m = torch.nn.Linear(2, 3)
+    sd = m.state_dict()
+    out = on_cpu(dict(policy=sd, optim={"state": {0: {"step": torch.tensor(3.0)}}, "param_groups": [{"lr": 1.0}]}))
+    assert out["policy"]._metadata == sd._metadata and torch.equal(out["policy"]["weight"], sd["weight"])
+    assert out["optim"]["param_groups"] == [{"lr": 1.0}] and float(out["optim"]["state"][0]["step"]) == 3.0
+    torch.nn.Linear(2, 3).load_state_dict(out["policy"])
 
 
 @pytest.mark.slow

@@ -408,16 +408,16 @@ class LeanCollector:
         return self.num_envs * self.horizon
 
     def set_actor(self, actor: torch.nn.Module, own_copy: bool = False) -> None:
-        """The module ``(hand, object, goal) -> (loc, scale)`` the envs act with; ``own_copy`` (env
-        workers only): they act with a copy of it that :meth:`sync_actor` refreshes."""
+        """The module ``(hand, object, goal) -> (loc, scale)`` the envs act with; ``own_copy``: they act
+        with a copy of it on the envs' device that :meth:`sync_actor` refreshes (overlapped collection,
+        or a learner on another device, ``optim.update_device``)."""
+        if own_copy:
+            self._learner, actor = actor, copy.deepcopy(actor).to(self.device)
         if self._local is not None:
-            if own_copy:
-                raise ValueError("overlapped collection needs env worker processes (num_envs > 1 on physx_cpu)")
+            self._shared = actor
             self._local.set_actor(actor)
             self.buf = make_buffer(self.num_envs, self.horizon, self.dims, self.n_act, self.device, self.teacher)
             return
-        if own_copy:
-            self._learner, actor = actor, copy.deepcopy(actor)
         actor.share_memory()
         self._shared = actor
         self.buf = make_buffer(self.num_envs, self.horizon, self.dims, self.n_act, teacher=self.teacher).share_memory_()
@@ -562,6 +562,32 @@ def check_overlap(overlap: bool, backend: str, num_envs: int, ray_address: Optio
         raise ValueError(f"collector.overlap needs env worker processes on this machine (env.backend physx_cpu, "
                          f"num_envs > 1, no collector.ray_address); this run has {backend}, {num_envs} env(s), "
                          f"ray_address {ray_address}")
+
+
+def resolve_update_device(value: Optional[str], backend: str) -> torch.device:
+    """``optim.update_device``: where the networks, GAE and the update live. null: where the envs'
+    tensors are (the CPU for physx_cpu, the GPU for physx_cuda); "cuda" (or "cuda:N") puts the
+    learner of CPU env workers on a GPU, the workers acting with a CPU copy refreshed after each
+    update; "auto": the GPU when torch sees one. Refused before any simulation when no GPU is there,
+    or with physx_cuda on another device than the envs'."""
+    envs = torch.device("cuda" if backend == "physx_cuda" else "cpu")
+    if value is None:
+        return envs
+    if value == "auto":
+        return torch.device("cuda") if torch.cuda.is_available() else envs
+    try:
+        dev = torch.device(value)
+    except (RuntimeError, TypeError) as e:
+        raise ValueError(f"optim.update_device must be null, 'auto', 'cpu' or 'cuda[:N]', not {value!r}") from e
+    if dev.type not in ("cpu", "cuda"):
+        raise ValueError(f"optim.update_device must be null, 'auto', 'cpu' or 'cuda[:N]', not {value!r}")
+    if dev.type == "cuda" and not torch.cuda.is_available():
+        raise ValueError(f"optim.update_device={value}: torch sees no CUDA device here (torch {torch.__version__}); "
+                         "leave it null to update on the CPU")
+    if backend == "physx_cuda" and dev.type != "cuda":
+        raise ValueError(f"optim.update_device={value} with env.backend physx_cuda: the envs' tensors are on the GPU, "
+                         "the update runs there (leave it null)")
+    return dev
 
 
 def make_collector(env_id: str, env_kwargs: dict, num_envs: int, horizon: int, seed: int, backend: str,

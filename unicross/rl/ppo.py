@@ -27,9 +27,10 @@ from unicross import registry as R
 from unicross.grasps import grasp_dataset_file
 from unicross.rewards import term_names
 from unicross.rl.algorithm import PPO, obs_stats_frozen
-from unicross.rl.collector import check_overlap, check_teacher, make_collector, resolve_num_envs
+from unicross.rl.collector import (check_overlap, check_teacher, make_collector, resolve_num_envs,
+                                   resolve_update_device)
 from unicross.rl.models import OBS_KEYS  # noqa: F401  (re-exported for benchmarks)
-from unicross.rl.runner import CKPT_NAME, Runner, atomic_save, git_commit, open_run  # noqa: F401  (re-exported)
+from unicross.rl.runner import CKPT_NAME, Runner, atomic_save, git_commit, on_cpu, open_run  # noqa: F401  (re-exported)
 
 
 def resolve_horizon(collector_cfg: dict, skill: str, num_envs: int) -> int:
@@ -179,6 +180,7 @@ class PPOTrainer(Runner):
         num_envs = resolve_num_envs(ec["num_envs"], ec["backend"], cfg["collector"].get("ray_address"))
         self.overlap = bool(cfg["collector"].get("overlap", False))
         check_overlap(self.overlap, ec["backend"], num_envs, cfg["collector"].get("ray_address"))
+        learner_device = resolve_update_device(cfg["optim"].get("update_device"), ec["backend"])
         self.horizon = resolve_horizon(cfg["collector"], skill, num_envs)
         # envs of a resumed run start from new seeds (not a replay of the first iteration's starts)
         seed = cfg["seed"] + 1000 * int((self.ckpt or {}).get("iteration", 0))
@@ -186,11 +188,12 @@ class PPOTrainer(Runner):
                                         cfg["collector"].get("ray_address"),
                                         noise_correlation=float(cfg["collector"].get("noise_correlation", 0.0)),
                                         teacher=teacher, residual=base is not None)
-        self.device = self.collector.device
+        self.device = self.collector.device  # the batches' (episode statistics are kept there)
+        self.learner_device = learner_device  # the networks', GAE's and the update's
         dims, self.n_act = self.collector.dims, self.collector.n_act
-        self.algo = PPO(dims, self.n_act, cfg, self.collector.frames_per_batch, self.device)
+        self.algo = PPO(dims, self.n_act, cfg, self.collector.frames_per_batch, self.learner_device)
         if start_mean is not None:
-            self.algo.actor.start_mean_at(start_mean.to(self.device))
+            self.algo.actor.start_mean_at(start_mean.to(self.learner_device))
         if start_policy is not None:
             self.algo.start_policy_from(start_policy, cfg["model"]["init_policy"])
         self.iteration, self.frames = 0, 0
@@ -209,8 +212,10 @@ class PPOTrainer(Runner):
                 if before[sec].get(key) != cfg[sec].get(key):
                     print(f"[unicross] resumed with {path}={cfg[sec].get(key)} (was {before[sec].get(key)}): "
                           f"{num_envs} envs x {self.horizon} steps = {num_envs * self.horizon} frames per iteration")
-        # after loading: the workers share these weights (overlap: a copy of them, synced per batch)
-        self.collector.set_actor(self.algo.actor, own_copy=self.overlap)
+        # after loading: the workers share these weights (overlap, or a learner on the GPU: a copy of
+        # them on the envs' device, synced per batch)
+        self._own_copy = self.overlap or self.learner_device != self.device
+        self.collector.set_actor(self.algo.actor, own_copy=self._own_copy)
         self._ep_return = torch.zeros(num_envs, 1, device=self.device)
         # the episode's success as the skill's protocol counts it (``Skill.success_once``: reached at any
         # step, never dropped; else at its last step), over the training episode
@@ -226,7 +231,8 @@ class PPOTrainer(Runner):
     optim = property(lambda self: self.algo.optim)
 
     def state(self) -> dict:
-        return dict(**self.algo.state_dict(), **self.runner_state(),
+        algo = self.algo.state_dict()
+        return dict(**(algo if self.learner_device.type == "cpu" else on_cpu(algo)), **self.runner_state(),
                     iteration=self.iteration, frames=self.frames, skill=self.skill,
                     axis=self.axis, hand=self.hand, env_id=self.env_id, env_kwargs=self.env_kwargs,
                     obs_dims=self.dims, n_act=self.n_act, modes=list(F.MODES),
@@ -364,6 +370,7 @@ class PPOTrainer(Runner):
             if self.overlap:  # collected during the previous update, with the weights from before it
                 data = self.collector.next_overlapped(more=self.frames + self.collector.frames_per_batch < total)
             else:
+                self.collector.sync_actor()  # a copy (learner on the GPU) takes the last update's weights
                 data = self.collector.collect()
             t_collect = time.perf_counter() - t_last
             self.iteration += 1
@@ -373,7 +380,7 @@ class PPOTrainer(Runner):
             ep["nonfinite"] = int(data["next", "info", "nonfinite"].sum())
             t0 = time.perf_counter()
             self.take_update_threads(busy_cores=self.collector.num_envs if self.overlap and self.collector.pending else 0)
-            up = self.algo.update(data)
+            up = self.algo.update(data if self.learner_device == self.device else data.to(self.learner_device))
             t_update = time.perf_counter() - t0
             bad = sorted(k for k, v in up.items() if isinstance(v, float) and not math.isfinite(v))
             if bad:  # an error: the last checkpoint stays as it was

@@ -15,6 +15,8 @@ is then the number of env actors (one CPU each), which may exceed this machine's
 """
 from __future__ import annotations
 
+import copy
+
 from typing import Optional
 
 import torch
@@ -92,12 +94,12 @@ class RayCollector:
 
     def set_actor(self, actor: torch.nn.Module, own_copy: bool = False) -> None:
         """The module ``(hand, object, goal) -> (loc, scale)`` the envs act with; its current
-        weights go to the env actors at every :meth:`collect` (``own_copy``, overlapped collection:
-        not on Ray)."""
-        if own_copy:
-            raise ValueError("overlapped collection (collector.overlap) runs in local env workers, not on Ray")
+        weights go to the env actors at every :meth:`collect` (the actors always act with their own
+        copy on the CPU, whatever ``own_copy`` says; overlapped collection is refused before the run,
+        :func:`unicross.rl.collector.check_overlap`)."""
         self.actor = actor
-        self._ray.get([a.set_actor.remote(actor) for a in self._actors])
+        cpu_copy = copy.deepcopy(actor).to("cpu")
+        self._ray.get([a.set_actor.remote(cpu_copy) for a in self._actors])
         self.buf = make_buffer(self.num_envs, self.horizon, self.dims, self.n_act)
 
     def _weights(self):

@@ -51,6 +51,21 @@ def fsync_dir(path: Path) -> None:
         os.close(fd)
 
 
+def on_cpu(tree):
+    """``tree`` (nested dicts, lists and tuples, e.g. a state dict with an optimiser's) with every
+    tensor on the CPU, so that a checkpoint of a learner on the GPU loads anywhere as it is."""
+    if isinstance(tree, torch.Tensor):
+        return tree.cpu()
+    if isinstance(tree, dict):
+        out = type(tree)((k, on_cpu(v)) for k, v in tree.items())
+        if hasattr(tree, "_metadata"):  # a module's state dict: its versions, as load_state_dict reads them
+            out._metadata = tree._metadata
+        return out
+    if isinstance(tree, (list, tuple)):
+        return type(tree)(on_cpu(v) for v in tree)
+    return tree
+
+
 def atomic_save(obj, path: Path) -> None:
     """``torch.save`` to a temporary file of this process, fsync, rename over ``path``, fsync the
     directory: a reader sees the old file or the new one, never a torn one."""
