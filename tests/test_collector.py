@@ -412,3 +412,27 @@ def test_alternate_envs_run_whole_episodes_and_change_nothing_at_share_zero():
                for k in bufs["none"].keys(include_nested=True, leaves_only=True))
     with pytest.raises(ValueError, match="CPU env workers"):
         LeanCollector("UniCross-Grasp-v1", KW, 2, 4, backend="physx_cuda", alternates=[chain], alternate_share=0.5)
+
+
+def test_ppo_learner_on_another_device_keeps_the_envs_copy_in_step(tmp_path, monkeypatch):
+    """optim.update_device (a learner on the GPU), run here with the learner declared elsewhere: the
+    env acts with a copy that takes the learner's weights before each batch, and the checkpoint is
+    written on the CPU."""
+    import unicross.rl.ppo as P
+    monkeypatch.setattr(P, "same_device", lambda a, b: False)
+    t = P.PPOTrainer(tmp_path / "run", "grasp", progress=False, overrides=dict(
+        env=dict(num_envs=1, object_limit=1, reconfiguration_freq=0),
+        collector=dict(total_frames=10 ** 6, horizon=16), optim=dict(minibatch_size=16, mini_epochs=1),
+        logging=dict(eval_trials=0, final_eval_trials=0, checkpoint_every=1)))
+    try:
+        copy = t.collector._shared
+        assert copy is not t.algo.actor
+        w0 = copy.net.main[-1].weight.clone()
+        t.train(max_iterations=2, eval_at_ends=False)
+        assert not torch.equal(copy.net.main[-1].weight, w0)  # synced before the second batch
+        t.collector.sync_actor()
+        assert torch.equal(copy.net.main[-1].weight, t.algo.actor.net.main[-1].weight)
+    finally:
+        t.close()
+    ck = torch.load(tmp_path / "run" / "checkpoint.pt", weights_only=False)
+    assert ck["iteration"] == 2 and all(v.device.type == "cpu" for v in ck["policy"].values())

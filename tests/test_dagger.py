@@ -220,3 +220,26 @@ def test_chain_share_adds_one_chain_per_in_hand_mode_on_the_multi_skill_objects(
         chain_envs(dict(kw, modes=["grasp", "rotate_x+"]), 0.5)
     with pytest.raises(ValueError, match="chain_share"):
         chain_envs(kw, 1.5)
+
+
+def test_learner_on_another_device_keeps_the_workers_copy_in_step(tmp_path, experts, monkeypatch):
+    """optim.update_device (a learner on the GPU), run here with the learner declared elsewhere: the
+    envs act with a copy that takes the student's weights before each rollout, the checkpoint is
+    written on the CPU and a resumed run goes on from it."""
+    import unicross.rl.dagger as D
+    monkeypatch.setattr(D, "same_device", lambda a, b: False)
+    t = DAggerTrainer(tmp_path / "run", experts, overrides=_tiny_cfg(epochs=3, grad_steps=3), progress=False)
+    copy = t.collector._shared
+    assert copy is not t.actor.module
+    w0 = copy.net.main[-1].weight.clone()
+    t.train()
+    assert not torch.equal(copy.net.main[-1].weight, w0)  # synced before the later rollouts
+    t.collector.sync_actor()
+    assert torch.equal(copy.net.main[-1].weight, t.actor.module.net.main[-1].weight)
+    t.close()
+    ck = torch.load(tmp_path / "run" / "checkpoint.pt", weights_only=False)
+    assert ck["epoch"] == 3 and all(v.device.type == "cpu" for v in ck["policy"].values())
+    r = DAggerTrainer(tmp_path / "run", None, resume=True, progress=False)
+    r.train(epochs=1)
+    assert r.epoch == 4
+    r.close()

@@ -564,6 +564,17 @@ def check_overlap(overlap: bool, backend: str, num_envs: int, ray_address: Optio
                          f"ray_address {ray_address}")
 
 
+def same_device(a, b) -> bool:
+    """Whether two torch devices are one ("cuda" and "cuda:0" are, on a process whose current GPU is 0)."""
+    a, b = torch.device(a), torch.device(b)
+    if a.type != b.type:
+        return False
+    if a.type != "cuda":
+        return True
+    current = torch.cuda.current_device() if torch.cuda.is_available() else 0
+    return (current if a.index is None else a.index) == (current if b.index is None else b.index)
+
+
 def resolve_update_device(value: Optional[str], backend: str) -> torch.device:
     """``optim.update_device``: where the networks, GAE and the update live. null: where the envs'
     tensors are (the CPU for physx_cpu, the GPU for physx_cuda); "cuda" (or "cuda:N") puts the

@@ -32,11 +32,12 @@ from tqdm import tqdm
 from unicross import formulation as F
 from unicross import registry as R
 from unicross.grasps import grasp_dataset_file
-from unicross.rl.collector import check_overlap, make_collector, resolve_num_envs
+from unicross.rl.collector import (check_overlap, make_collector, resolve_num_envs, resolve_update_device,
+                                   same_device)
 from unicross.rl.models import OBS_KEYS, make_models
 from unicross.rl.policy_io import base_policy_of, load_policy
 from unicross.rl.ppo import adopt_input_floor, policy_to_start_from
-from unicross.rl.runner import CKPT_NAME, Runner, atomic_save
+from unicross.rl.runner import CKPT_NAME, Runner, atomic_save, on_cpu
 
 
 def expert_paths(experts_dir, modes=F.MODES) -> Dict[str, Path]:
@@ -140,7 +141,8 @@ class DAggerTrainer(Runner):
             kw["object_limit"] = ec["object_limit"]
         if ec.get("grasp_dataset"):
             kw["grasp_dataset"] = grasp_dataset_file(ec["grasp_dataset"])
-        self.device = torch.device("cuda" if ec["backend"] == "physx_cuda" else "cpu")
+        # the learner's device (teachers, student, labels, updates): optim.update_device, null: the envs'
+        self.device = resolve_update_device(cfg["optim"].get("update_device"), ec["backend"])
         self.share_cores(ec["backend"])
         self.teachers = Teachers(paths, self.device)
         kw["hand"] = self.teachers.hand
@@ -175,17 +177,22 @@ class DAggerTrainer(Runner):
         self.student.to(self.device)
         self.actor = self.student.module[0]  # hand/object/goal -> loc, scale
         self.optim = torch.optim.Adam(self.actor.parameters(), lr=cfg["optim"]["lr"])
-        self.rb = TensorDictReplayBuffer(storage=LazyTensorStorage(cfg["buffer"]["capacity"], device=self.device),
+        # the replay buffer stays with the envs' batches (the CPU for CPU env workers); minibatches go to the learner
+        self.rb = TensorDictReplayBuffer(storage=LazyTensorStorage(cfg["buffer"]["capacity"],
+                                                                   device=self.collector.device),
                                          batch_size=cfg["optim"]["batch_size"])
         self.epoch, self.frames = 0, 0
         if self.ckpt is not None:
             self._load(self.ckpt)
-        # after loading: the workers share these weights (overlap: a copy of them, synced per epoch)
-        self.collector.set_actor(self.actor.module, own_copy=self.overlap)
+        # after loading: the workers share these weights (overlap, or a learner on the GPU: a copy of them on the
+        # envs' device, synced per epoch)
+        self._elsewhere = not same_device(self.device, self.collector.device)
+        self.collector.set_actor(self.actor.module, own_copy=self.overlap or self._elsewhere)
 
     # ------------------------------------------------------------------ state
     def state(self) -> dict:
-        return dict(**self.runner_state(), policy=self.student.state_dict(), optim=self.optim.state_dict(),
+        learner = dict(policy=self.student.state_dict(), optim=self.optim.state_dict())
+        return dict(**self.runner_state(), **(on_cpu(learner) if self._elsewhere else learner),
                     epoch=self.epoch, frames=self.frames, experts_dir=self.experts_dir, skill="multi", axis=None,
                     hand=self.teachers.hand, obs_dims=self.dims, n_act=self.n_act, modes=list(F.MODES),
                     distilled_modes=list(self.teachers.modes), env_kwargs=self.env_kwargs)
@@ -230,13 +237,17 @@ class DAggerTrainer(Runner):
         ``collector.overlap`` the rollout was made during the previous epoch's update, with the
         student of the epoch before (DAgger's labels do not depend on who acted); the workers then
         take the current student and, if ``more`` epochs follow, start the next rollout."""
-        data = self.collector.next_overlapped(more) if self.overlap else self.collector.collect()
-        flat = data.reshape(-1)
+        if self.overlap:
+            data = self.collector.next_overlapped(more)
+        else:
+            self.collector.sync_actor()  # a copy (learner on the GPU) takes the last update's weights
+            data = self.collector.collect()
+        flat = data.reshape(-1).to(self.device)
         labels = self.teachers(flat)
         item = flat.select(*OBS_KEYS).clone()
         item["expert_action"] = labels
         item["mode"] = flat["goal"][..., :F.NUM_MODES].argmax(-1)
-        self.rb.extend(item)
+        self.rb.extend(item.to(self.collector.device) if self._elsewhere else item)
         self.norm.update({k: item[k] for k in OBS_KEYS})
         self.frames += flat.numel()
         done = flat["next", "done"].squeeze(-1)
@@ -258,6 +269,8 @@ class DAggerTrainer(Runner):
         per_mode, counts = torch.zeros(F.NUM_MODES), torch.zeros(F.NUM_MODES)
         for _ in range(oc["grad_steps"]):
             b = self.rb.sample()
+            if self._elsewhere:
+                b = b.to(self.device)
             obs, target = b.select(*OBS_KEYS).clone(), b["expert_action"]
             moved = torch.zeros(obs.batch_size[0], dtype=torch.bool, device=target.device)
             if noise > 0:
@@ -311,6 +324,7 @@ class DAggerTrainer(Runner):
     @torch.no_grad()
     def action_mse(self, td: TensorDict) -> Dict[str, float]:
         """Per-mode MSE between the student's mean action and the experts' labels on ``td``."""
+        td = td.to(self.device)
         labels = self.teachers(td)
         pred = self.actor(td.select(*OBS_KEYS).clone())["loc"]
         err = ((pred - labels) ** 2).mean(-1)

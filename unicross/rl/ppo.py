@@ -28,7 +28,7 @@ from unicross.grasps import grasp_dataset_file
 from unicross.rewards import term_names
 from unicross.rl.algorithm import PPO, obs_stats_frozen
 from unicross.rl.collector import (check_overlap, check_teacher, make_collector, resolve_num_envs,
-                                   resolve_update_device)
+                                   resolve_update_device, same_device)
 from unicross.rl.models import OBS_KEYS  # noqa: F401  (re-exported for benchmarks)
 from unicross.rl.runner import CKPT_NAME, Runner, atomic_save, git_commit, on_cpu, open_run  # noqa: F401  (re-exported)
 
@@ -214,7 +214,8 @@ class PPOTrainer(Runner):
                           f"{num_envs} envs x {self.horizon} steps = {num_envs * self.horizon} frames per iteration")
         # after loading: the workers share these weights (overlap, or a learner on the GPU: a copy of
         # them on the envs' device, synced per batch)
-        self._own_copy = self.overlap or self.learner_device != self.device
+        self._elsewhere = not same_device(self.learner_device, self.device)
+        self._own_copy = self.overlap or self._elsewhere
         self.collector.set_actor(self.algo.actor, own_copy=self._own_copy)
         self._ep_return = torch.zeros(num_envs, 1, device=self.device)
         # the episode's success as the skill's protocol counts it (``Skill.success_once``: reached at any
@@ -232,7 +233,7 @@ class PPOTrainer(Runner):
 
     def state(self) -> dict:
         algo = self.algo.state_dict()
-        return dict(**(algo if self.learner_device.type == "cpu" else on_cpu(algo)), **self.runner_state(),
+        return dict(**(on_cpu(algo) if self._elsewhere else algo), **self.runner_state(),
                     iteration=self.iteration, frames=self.frames, skill=self.skill,
                     axis=self.axis, hand=self.hand, env_id=self.env_id, env_kwargs=self.env_kwargs,
                     obs_dims=self.dims, n_act=self.n_act, modes=list(F.MODES),
@@ -380,7 +381,7 @@ class PPOTrainer(Runner):
             ep["nonfinite"] = int(data["next", "info", "nonfinite"].sum())
             t0 = time.perf_counter()
             self.take_update_threads(busy_cores=self.collector.num_envs if self.overlap and self.collector.pending else 0)
-            up = self.algo.update(data if self.learner_device == self.device else data.to(self.learner_device))
+            up = self.algo.update(data.to(self.learner_device) if self._elsewhere else data)
             t_update = time.perf_counter() - t0
             bad = sorted(k for k, v in up.items() if isinstance(v, float) and not math.isfinite(v))
             if bad:  # an error: the last checkpoint stays as it was
