@@ -436,3 +436,29 @@ def test_ppo_learner_on_another_device_keeps_the_envs_copy_in_step(tmp_path, mon
         t.close()
     ck = torch.load(tmp_path / "run" / "checkpoint.pt", weights_only=False)
     assert ck["iteration"] == 2 and all(v.device.type == "cpu" for v in ck["policy"].values())
+
+
+@pytest.mark.skipif(not torch.cuda.is_available(), reason="needs a CUDA device (optim.update_device=cuda)")
+def test_ppo_learner_on_the_gpu(tmp_path):
+    """optim.update_device=cuda with CPU env workers: the learner on the GPU, the workers' copy on the
+    CPU in step with it, a checkpoint on the CPU that a resumed run goes on from."""
+    from unicross.rl.ppo import PPOTrainer
+    over = dict(env=dict(num_envs=2, object_limit=1, reconfiguration_freq=0), optim=dict(update_device="cuda"),
+                collector=dict(total_frames=10 ** 6, frames_per_batch=64), logging=dict(eval_trials=0,
+                                                                                      final_eval_trials=0, checkpoint_every=1))
+    t = PPOTrainer(tmp_path / "run", "grasp", progress=False, overrides=over)
+    try:
+        assert next(t.algo.actor.parameters()).is_cuda and not next(t.collector._shared.parameters()).is_cuda
+        t.train(max_iterations=2, eval_at_ends=False)
+        t.collector.sync_actor()
+        assert torch.equal(t.collector._shared.net.main[-1].weight, t.algo.actor.net.main[-1].weight.cpu())
+    finally:
+        t.close()
+    ck = torch.load(tmp_path / "run" / "checkpoint.pt", weights_only=False, map_location="cpu")
+    assert all(v.device.type == "cpu" for v in ck["policy"].values())
+    r = PPOTrainer(tmp_path / "run", resume=True, progress=False)
+    try:
+        r.train(max_iterations=1, eval_at_ends=False)
+        assert r.iteration == 3
+    finally:
+        r.close()

@@ -243,3 +243,20 @@ def test_learner_on_another_device_keeps_the_workers_copy_in_step(tmp_path, expe
     r.train(epochs=1)
     assert r.epoch == 4
     r.close()
+
+
+@pytest.mark.skipif(not torch.cuda.is_available(), reason="needs a CUDA device (optim.update_device=cuda)")
+def test_dagger_learner_on_the_gpu(tmp_path, experts):
+    """optim.update_device=cuda: teachers and student on the GPU, the replay buffer and the workers'
+    copy on the CPU, the checkpoint on the CPU."""
+    over = _tiny_cfg(num_envs=2, epochs=3, grad_steps=3)
+    over["optim"]["update_device"] = "cuda"
+    t = DAggerTrainer(tmp_path / "run", experts, overrides=over, progress=False)
+    assert next(t.actor.parameters()).is_cuda and not next(t.collector._shared.parameters()).is_cuda
+    t.train()
+    t.collector.sync_actor()
+    assert torch.equal(t.collector._shared.net.main[-1].weight, t.actor.module.net.main[-1].weight.cpu())
+    assert t.rb[:]["expert_action"].device.type == "cpu"
+    t.close()
+    ck = torch.load(tmp_path / "run" / "checkpoint.pt", weights_only=False, map_location="cpu")
+    assert all(v.device.type == "cpu" for v in ck["policy"].values())

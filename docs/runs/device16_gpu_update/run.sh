@@ -1,8 +1,10 @@
 #!/bin/bash
 # Issue #12 on a lent 16-core machine with a GPU (2026-12-04, 45th session), one call:
-#   1. tests/test_algorithm.py::test_update_on_the_gpu_matches_the_cpu (skipped where there is no GPU):
-#      the PPO update with optim.update_device=cuda against the CPU's on the same batches;
-#   2. benchmarks/scaling.py --workers 2 4 8 16 with collector.overlap and --update-devices cpu cuda: the
+#   1. the tests skipped where there is no GPU: tests/test_algorithm.py::test_update_on_the_gpu_matches_the_cpu
+#      (the PPO update with optim.update_device=cuda against the CPU's on the same batches),
+#      tests/test_collector.py::test_ppo_learner_on_the_gpu and tests/test_dagger.py::test_dagger_learner_on_the_gpu
+#      (the trainers with CPU env workers and the learner on the GPU, checkpoint and resume);
+#   2. benchmarks/scaling.py --workers 2 8 16 with collector.overlap and --update-devices cpu cuda: the
 #      learner on the CPU and on the GPU, each worker count, in the same run (compiled step math, the
 #      default 1024-frame batch, the real PPO update), JSON + PNG;
 #   3. if time is left: 16 workers with 4096-frame batches, the same two update devices.
@@ -19,13 +21,13 @@ export PYTHONPATH=/tmp/site
 { nproc; lscpu | grep "Model name"; nvidia-smi --query-gpu=name --format=csv,noheader;
   python3 -c "import torch, sys; print('torch', torch.__version__, 'python', sys.version.split()[0], 'cuda', torch.cuda.is_available())"; } >> "$OUT/log.txt" 2>&1
 el "installed"
-timeout 90 python3 -m pytest -q -p no:cacheprovider tests/test_algorithm.py -k "gpu or bandit" > "$OUT/pytest_gpu.txt" 2>&1
+timeout 150 python3 -m pytest -q -p no:cacheprovider tests/test_algorithm.py tests/test_collector.py tests/test_dagger.py -k "gpu or bandit" > "$OUT/pytest_gpu.txt" 2>&1
 el "gpu test rc=$? $(tail -1 "$OUT/pytest_gpu.txt")"
 SRC=$PWD
 mkdir -p /tmp/w && cd /tmp/w  # outside the source tree
 cp "$SRC/benchmarks/scaling.py" .
 el "scaling, overlap, update on cpu and cuda"
-timeout 400 python3 scaling.py --workers 2 4 8 16 --iterations 5 --env-steps 1000 --set collector.overlap=true \
+timeout 320 python3 scaling.py --workers 2 8 16 --iterations 5 --env-steps 1000 --set collector.overlap=true \
   --update-devices cpu cuda --json "$OUT/scaling_gpu_update.json" --png "$OUT/scaling_gpu_update.png" \
   > "$OUT/scaling.log" 2> "$OUT/scaling.err"
 el "  rc=$?"
