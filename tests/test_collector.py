@@ -195,6 +195,10 @@ def test_overlapped_workers_act_with_their_own_copy_until_synced():
         assert not torch.equal(one._shared.net.main[-1].bias, actor.net.main[-1].bias)
         one.sync_actor()
         assert torch.equal(one._shared.net.main[-1].bias, actor.net.main[-1].bias)
+        with torch.no_grad():
+            actor.net.main[-1].bias.add_(-0.3)
+        one.map_shards(evaluation_shard, **kw)  # an evaluation runs the learner's current weights
+        assert torch.equal(one._shared.net.main[-1].bias, actor.net.main[-1].bias)
     finally:
         one.close()
 

@@ -508,6 +508,7 @@ class LeanCollector:
         evaluation split over objects; returns the n results. One env in the main process: one call
         with ``shard=None``. ``fn`` must be a module-level function (it is pickled)."""
         if self._local is not None:
+            self.sync_actor()  # a copy (learner on the GPU) evaluates the learner's current weights
             with one_thread():
                 return [fn(self._local.actor, shard=None, **kwargs)]
         if self._pending:  # a batch in flight: kept for the next finish()
