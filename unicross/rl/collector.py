@@ -378,7 +378,7 @@ class LeanCollector:
         kw = dict(env_kwargs)
         self._procs, self._conns, self._local, self.buf = [], [], None, None
         self._learner: Optional[torch.nn.Module] = None  # the actor the workers' copy follows (own_copy)
-        self._shared: Optional[torch.nn.Module] = None  # the actor in shared memory the workers run
+        self._shared: Optional[torch.nn.Module] = None  # the actor the envs run (in shared memory for worker processes)
         self._pending = False  # a batch is being collected (start() without finish())
         self._stash: Optional[TensorDict] = None  # a finished batch not yet taken (see map_shards)
         if backend == "physx_cuda":
@@ -413,13 +413,12 @@ class LeanCollector:
         or a learner on another device, ``optim.update_device``)."""
         if own_copy:
             self._learner, actor = actor, copy.deepcopy(actor).to(self.device)
+        self._shared = actor
         if self._local is not None:
-            self._shared = actor
             self._local.set_actor(actor)
             self.buf = make_buffer(self.num_envs, self.horizon, self.dims, self.n_act, self.device, self.teacher)
             return
         actor.share_memory()
-        self._shared = actor
         self.buf = make_buffer(self.num_envs, self.horizon, self.dims, self.n_act, teacher=self.teacher).share_memory_()
         for conn in self._conns:
             conn.send(("setup", (actor, self.buf)))

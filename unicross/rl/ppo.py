@@ -215,8 +215,7 @@ class PPOTrainer(Runner):
         # after loading: the workers share these weights (overlap, or a learner on the GPU: a copy of
         # them on the envs' device, synced per batch)
         self._elsewhere = not same_device(self.learner_device, self.device)
-        self._own_copy = self.overlap or self._elsewhere
-        self.collector.set_actor(self.algo.actor, own_copy=self._own_copy)
+        self.collector.set_actor(self.algo.actor, own_copy=self.overlap or self._elsewhere)
         self._ep_return = torch.zeros(num_envs, 1, device=self.device)
         # the episode's success as the skill's protocol counts it (``Skill.success_once``: reached at any
         # step, never dropped; else at its last step), over the training episode
