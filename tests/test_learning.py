@@ -300,6 +300,9 @@ def _shipped_and_zero(spec: str, skill: str, axis: str, objects, trials_per_obje
 
 @pytest.mark.parametrize("hand,axis,names,trials_per_object", [
     ("allegro", "z+", None, 2), ("sharpa_wave", "z+", None, 2),
+    # Allegro's z- expert (a clone of a two-phase finger sequence, 84% of the report's test cell): its first
+    # elongated test object, pulled in 5 of 5 trials there (docs/runs/translate_zm_reference/second_phase/clone_s0)
+    ("allegro", "z-", None, 2),
     # Sharpa Wave's z- expert (a clone of a finger sequence searched under 12 solver iterations, 35% of the
     # report's test cell): two test objects it pulled in 1 and 2 of their first 3 trials there
     ("sharpa_wave", "z-", ["elongated-box-test-100", "elongated-cylinder-test-108"], 3)])
