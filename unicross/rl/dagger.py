@@ -21,7 +21,7 @@ import os
 import shutil
 import time
 from pathlib import Path
-from typing import Dict, Optional
+from typing import Dict, Optional, Sequence
 
 import torch
 from tensordict import TensorDict
@@ -49,6 +49,20 @@ def expert_paths(experts_dir, modes=F.MODES) -> Dict[str, Path]:
                                 f"(expected <experts>/<mode>/checkpoint.pt, e.g. from "
                                 f"`unicross train --skill rotate --axis x+ --out {d}/rotate_x+`)")
     return paths
+
+
+def walked_modes(modes: Sequence[str], repeats: Optional[Dict[str, int]]) -> list:
+    """``env.mode_repeats``: ``modes`` with mode ``m`` written ``repeats[m]`` times in a row, as the
+    multi-skill env walks them (:func:`tasks.base.pair_walk` takes one pair per listed mode per round),
+    so the student meets that mode's states ``repeats[m]`` times as often; the chains repeat with it."""
+    repeats = dict(repeats or {})
+    unknown = sorted(set(repeats) - set(modes))
+    if unknown:
+        raise ValueError(f"env.mode_repeats: {unknown} not among the run's modes {list(modes)}")
+    bad = {m: k for m, k in repeats.items() if not isinstance(k, int) or isinstance(k, bool) or k < 1}
+    if bad:
+        raise ValueError(f"env.mode_repeats: repeats are whole numbers >= 1, got {bad}")
+    return [m for m in modes for _ in range(repeats.get(m, 1))]
 
 
 def chain_envs(multi_kwargs: dict, share: float) -> list:
@@ -132,7 +146,7 @@ class DAggerTrainer(Runner):
         modes = cfg["env"]["modes"] or list(F.MODES)
         paths = expert_paths(experts_dir, modes)  # refuses to start without every expert
         ec = cfg["env"]
-        kw = dict(randomize=ec["randomize"], modes=modes,
+        kw = dict(randomize=ec["randomize"], modes=walked_modes(modes, ec.get("mode_repeats")),
                   reconfiguration_freq=ec["reconfiguration_freq"] if ec["backend"] == "physx_cpu" else 0,
                   config=ec["task_config"] or None)
         if ec.get("objects"):
