@@ -222,6 +222,27 @@ def test_chain_share_adds_one_chain_per_in_hand_mode_on_the_multi_skill_objects(
         chain_envs(kw, 1.5)
 
 
+def test_mode_repeats_walk_a_mode_and_its_chains_k_times():
+    """env.mode_repeats={m: k}: the multi-skill env's pair walk takes k pairs of m per round (the others
+    one), chains of m come k times; unknown modes and repeats under 1 are refused before any env."""
+    from tasks.base import pair_walk
+    from unicross import formulation as F
+    from unicross.rl.dagger import chain_envs, walked_modes
+    assert walked_modes(F.MODES, {}) == list(F.MODES) == walked_modes(F.MODES, None)
+    modes = walked_modes(F.MODES, {"rotate_y+": 2})
+    assert len(modes) == 11 and modes.count("rotate_y+") == 2 and set(modes) == set(F.MODES)
+    walk = pair_walk([[0, 1, 2]] * len(modes), [F.MODES.index(m) for m in modes], "sequential")
+    yplus = F.MODES.index("rotate_y+")
+    assert sum(m == yplus for _, m in walk) == 6 and sum(m == 0 for _, m in walk) == 3
+    kw = dict(randomize=True, modes=modes, reconfiguration_freq=2, config=None, hand="allegro")
+    assert [k["sequence"][-1] for _, k in chain_envs(kw, 0.2)].count("rotate_y+") == 2
+    with pytest.raises(ValueError, match="not among"):
+        walked_modes(["grasp", "relocate"], {"rotate_y+": 2})
+    for bad in (0, 1.5, True):
+        with pytest.raises(ValueError, match="whole numbers"):
+            walked_modes(F.MODES, {"rotate_y+": bad})
+
+
 def test_learner_on_another_device_keeps_the_workers_copy_in_step(tmp_path, experts, monkeypatch):
     """optim.update_device (a learner on the GPU), run here with the learner declared elsewhere: the
     envs act with a copy that takes the student's weights before each rollout, the checkpoint is
