@@ -57,7 +57,8 @@ def evaluate(job):
     from unicross.objects import get_object_set
     from unicross.sequences import make_sequence_policy
     torch.set_num_threads(1)
-    objs = [o for o in get_object_set("train") if o.name in set(names)]
+    names = set(names)
+    objs = [o for o in get_object_set("train") if o.name in names]
     tr = E.run_protocol("translate", make_sequence_policy(spec), objs, trials_per_object=trials, seed=seed,
                         axes=["z-"], progress=False)
     score = float(np.mean([1.0 if t["success"] else (0.0 if t["dropped"] else
@@ -70,12 +71,8 @@ def sticks():
     return [o.name for o in get_object_set("train") if o.category == "elongated"]
 
 
-def halves(names, workers):
-    return [names[i::workers] for i in range(workers)]
-
-
 def run(pool, spec, seed, names, trials, workers):
-    parts = pool.map(evaluate, [(spec, seed, h, trials) for h in halves(names, workers)])
+    parts = pool.map(evaluate, [(spec, seed, names[i::workers], trials) for i in range(workers)])
     n = sum(p[3] for p in parts)
     return (sum(p[0] * p[3] for p in parts) / n, sum(p[1] for p in parts), sum(p[2] for p in parts), n)
 
