@@ -85,3 +85,26 @@ def test_report_names_what_a_clone_copied():
     from unicross.report import how_trained
     assert how_trained({"clone_of": "seq:index:2:0.05:0:10", "config": {}}).startswith("DAgger clone of seq:index:2:")
     assert how_trained({"clone_of": "allegro/rotate_y-", "config": {}}).startswith("DAgger clone of gait:allegro/rotate_y-")
+
+
+def test_a_switched_sequence_runs_each_envs_branch_by_its_objects_width():
+    from unicross.objects import ObjectSpec
+    u = _env()
+    u.env_objects = [ObjectSpec(name=f"s{i}", shape="box", category="elongated", dims=(0.7, w, 0.06))
+                     for i, w in enumerate((0.045, 0.055, 0.0489))]
+    policy = make_sequence_policy("width<0.049?index:2:0.05:0:10|ring:2:0.05:0:10")
+    index = finger_sweep_action(u.hand_spec, 0.05, ("index", 2))
+    ring = finger_sweep_action(u.hand_spec, 0.05, ("ring", 2))
+    a = policy(None, u)
+    assert torch.equal(a[0], index) and torch.equal(a[1], ring) and torch.equal(a[2], index)
+    u.env_objects = list(reversed(u.env_objects))  # a rebuilt scene: the mask follows its objects
+    a = policy(None, u)
+    assert torch.equal(a[0], index) and torch.equal(a[1], ring) and torch.equal(a[2], index)
+
+
+@pytest.mark.parametrize("spec, msg", [("width<0.049?index:2:0.05:0:10", "width<W"),
+                                       ("width<thin?index:2:0.05:0:10|ring:2:0.05:0:10", "must be a number"),
+                                       ("width<0.049?index:2:0.05:0:10|ring:two:0.05:0:10", "integers")])
+def test_malformed_switched_sequences_are_refused(spec, msg):
+    with pytest.raises(ValueError, match=msg):
+        parse_sequence(spec)

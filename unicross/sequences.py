@@ -14,11 +14,18 @@ Translate z- example (``docs/runs/translate_zm_reference/``): ``index:2:0.05:0:4
 curls the index finger's two distal joints (the shipped physical reference) and, once the index's
 distal command has reached 0.9 rad, the ring finger's too. Per-env batched: each env has its own
 clock and trigger.
+
+A teacher may also pick its sequence by the object: ``width<W?THIN|THICK`` runs the sequence ``THIN``
+on objects whose smaller width across their long axis (:func:`cross_width`, m) is under ``W`` and
+``THICK`` on the others. The width is privileged (read from the env's object specs, not the
+observation): such a sequence is a teacher for a clone, whose network has to infer the width
+(``docs/runs/translate_zm_reference/thickness/``).
 """
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
-from typing import List, Optional
+from typing import List, Optional, Tuple
 
 import torch
 
@@ -34,8 +41,40 @@ class Sweep:
     theta: float = 0.0             # ... once it has reached theta rad
 
 
+_SWITCH = re.compile(r"width<([^?]*)\?([^|]*)\|([^|]*)")
+
+
+def split_switch(spec: str) -> Optional[Tuple[float, str, str]]:
+    """``(W, THIN, THICK)`` of a switched spec ``width<W?THIN|THICK``, or None for a plain sequence."""
+    if not spec.startswith("width<"):
+        return None
+    m = _SWITCH.fullmatch(spec)
+    if m is None:
+        raise ValueError(f"switched sequence {spec[:40]!r}...: write width<W?THIN|THICK (W in m)")
+    try:
+        w = float(m.group(1))
+    except ValueError:
+        raise ValueError(f"switched sequence: the width {m.group(1)!r} must be a number (m)") from None
+    if not w > 0:
+        raise ValueError(f"switched sequence: the width {w} must be > 0 (m)")
+    return w, m.group(2), m.group(3)
+
+
+def cross_width(obj) -> float:
+    """The smaller width (m) of ``obj`` (an :class:`unicross.objects.ObjectSpec`) across its long axis x:
+    ``min(dims[1:])`` (a box's two widths, a cylinder's or prism's diameter); a sphere's diameter."""
+    d = obj.dims
+    if not d:
+        raise ValueError(f"object {obj.name!r} has no dims: a switched sequence needs a primitive shape")
+    return float(min(d[1:])) if len(d) > 1 else float(d[0])
+
+
 def parse_sequence(spec: str) -> List[Sweep]:
-    """The sweeps of ``spec``; a malformed spec raises ``ValueError`` saying which term and why."""
+    """The sweeps of ``spec`` (of both branches for a switched spec); a malformed spec raises
+    ``ValueError`` saying which term and why."""
+    switch = split_switch(spec)
+    if switch is not None:
+        return parse_sequence(switch[1]) + parse_sequence(switch[2])
     sweeps = []
     for term in spec.split("+"):
         parts = term.split(":")
@@ -72,9 +111,13 @@ def check_sequence(spec: str, hand_spec) -> List[Sweep]:
 
 def make_sequence_policy(spec: str):
     """A policy ``(obs, env) -> action [n, dof]`` that sums the sweeps of ``spec`` active at each env's
-    control step (see the module docstring); triggers latch per env and clear at its step 0."""
+    control step (see the module docstring); triggers latch per env and clear at its step 0. A switched
+    spec runs each env's branch by its object's :func:`cross_width`."""
     from unicross.audit import finger_sweep_action
     parse_sequence(spec)  # a malformed spec fails before any simulation
+    switch = split_switch(spec)
+    if switch is not None:
+        return _switched_policy(*switch)
     cache = {}
 
     def policy(obs, u) -> torch.Tensor:
@@ -99,4 +142,17 @@ def make_sequence_policy(spec: str):
                 active = on[:, i:i + 1]
             a = a + sweep * active
         return a.clamp(-1.0, 1.0)
+    return policy
+
+
+def _switched_policy(width: float, thin: str, thick: str):
+    thin_policy, thick_policy = make_sequence_policy(thin), make_sequence_policy(thick)
+    cache = {}
+
+    def policy(obs, u) -> torch.Tensor:
+        objects = u.env_objects  # rebuilt with the scene: a new list, a new mask
+        if cache.get("objects") is not objects:
+            cache.update(objects=objects, thin=torch.tensor([cross_width(o) < width for o in objects],
+                                                            device=u.device)[:, None])
+        return torch.where(cache["thin"], thin_policy(obs, u), thick_policy(obs, u))
     return policy

@@ -15,6 +15,8 @@ starts (seed 500).
     python search3.py ../second_phase/chosen.txt OUTDIR [--generations 6 --population 16 --select 6]   # rule.txt 1-2
     python search3.py ../second_phase/chosen.txt OUTDIR --generations 8 --per-group 24 --sigma1 0.004 \
         --sigma2 0.008 --select-starts 2                                                             # rule.txt 6
+    python search3.py ../second_phase/chosen.txt OUTDIR --max-width 0.049 --generations 8 --per-group 12 --starts 4 \
+        --sigma1 0.006 --sigma2 0.010 --select-starts 4                                 # ../thickness/rule.txt 1-2
 """
 import argparse
 import json
@@ -66,9 +68,11 @@ def evaluate(job):
     return score, sum(t["success"] for t in tr), sum(t["dropped"] for t in tr), len(tr)
 
 
-def sticks():
+def sticks(max_width=None):
+    """The training sticks, or with ``max_width`` those whose smaller cross-section width (m) is under it."""
     from unicross.objects import get_object_set
-    return [o.name for o in get_object_set("train") if o.category == "elongated"]
+    return [o.name for o in get_object_set("train") if o.category == "elongated"
+            and (max_width is None or min(o.dims[1:]) < max_width)]
 
 
 def run(pool, spec, seed, names, trials, workers):
@@ -89,6 +93,8 @@ def main():
     ap.add_argument("--starts", type=int, default=2, help="starts per drawn stick")
     ap.add_argument("--select", type=int, default=6)
     ap.add_argument("--select-starts", type=int, default=1, help="starts per training stick in the selection")
+    ap.add_argument("--max-width", type=float, default=None,
+                    help="search and select on the sticks thinner than this (m, smaller cross-section width) only")
     ap.add_argument("--workers", type=int, default=2)
     a = ap.parse_args()
     start = open(a.start).read().strip()
@@ -96,7 +102,7 @@ def main():
     rng = np.random.default_rng(0)
     mu = params_of(start)
     sigma = np.array([a.sigma1] * 8 + [a.sigma2] * 8)
-    all_sticks = sticks()
+    all_sticks = sticks(a.max_width)
     boxes = [s for s in all_sticks if "-box-" in s]
     cyls = [s for s in all_sticks if "-cylinder-" in s]
     path = os.path.join(a.outdir, "search.jsonl")
