@@ -25,21 +25,26 @@ def pooled(paths):
             for k in per[0]}
 
 
-new, old = pooled(sys.argv[1:]), pooled(SHIPPED)
-gate = len(sys.argv) == 2
-slack = 8.0 if gate else 5.0
-ok = True
-print(f"{'cell':22s} {'this recipe':>20s} {'shipped stage':>20s}  bar")
-for k in new:
-    if k == "translate_z-":
-        bar = 79.0
-    elif gate and k == "rotate_y+":
-        bar = 44.0
-    else:
-        bar = old[k][0] - slack
-    passed = new[k][0] >= bar - 1e-9
-    ok &= passed
-    print(f"{k:22s} {new[k][0]:6.1f} ({new[k][1]:>11s}) {old[k][0]:6.1f} ({old[k][1]:>11s})  >= {bar:5.1f} "
-          f"{'ok' if passed else 'MISSED'}")
-step = "step 2 (gate to seeds 1 and 2)" if gate else "step 3 (ship seed 0)"
-print(f"{step}: {'PASSED' if ok else 'FAILED'}")
+def main():
+    new, old = pooled(sys.argv[1:]), pooled(SHIPPED)
+    gate = len(sys.argv) == 2
+    slack = 8.0 if gate else 5.0
+    ok = True
+    print(f"{'cell':22s} {'this recipe':>20s} {'shipped stage':>20s}  bar")
+    for k in new:
+        if k == "translate_z-":
+            bar = 79.0
+        elif gate and k == "rotate_y+":
+            bar = 44.0
+        else:
+            bar = old[k][0] - slack
+        passed = new[k][0] >= bar - 1e-9
+        ok &= passed
+        print(f"{k:22s} {new[k][0]:6.1f} ({new[k][1]:>11s}) {old[k][0]:6.1f} ({old[k][1]:>11s})  >= {bar:5.1f} "
+              f"{'ok' if passed else 'MISSED'}")
+    step = "step 2 (gate to seeds 1 and 2)" if gate else "step 3 (ship seed 0)"
+    print(f"{step}: {'PASSED' if ok else 'FAILED'}")
+
+
+if __name__ == "__main__":
+    main()

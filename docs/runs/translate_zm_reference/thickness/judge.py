@@ -7,23 +7,16 @@ Passes iff its translate z- cell is within 5 points of the new expert's (clone_s
 trials) and no other mode or long-horizon cell is more than 5 points below the shipped student's
 (../../student_yplus_repeat/cells_init_seed0.json, the cells of the student of 2026-12-05).
 """
-import json
 import os
 import sys
 
 from unicross.evaluation import read_results
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-SHIPPED = os.path.join(HERE, "..", "..", "student_yplus_repeat", "cells_init_seed0.json")
-CHAINS = ("Gr. + Re. + Rot.", "Gr. + Re. + Trans.")
-
-
-def cells(path):
-    d = json.load(open(path))
-    out = {m: (c["summary"]["successes"], c["summary"]["n"]) for m, c in d["test"].items()}
-    out.update({k: (v["overall"]["successes"], v["overall"]["n"]) for k, v in d["long_horizon"]["summary"].items()
-                if k in CHAINS})
-    return out
+STAGE = os.path.join(HERE, "..", "..", "student_yplus_repeat")
+SHIPPED = os.path.join(STAGE, "cells_init_seed0.json")
+sys.path.insert(0, STAGE)
+from judge import counts as cells  # noqa: E402  (the cells of a seed_cells.py output: (successes, n) by name)
 
 
 def main():
