@@ -59,6 +59,9 @@ new = dict(
                "the expert it replaces (12 iterations)": evaluation(
                    "docs/runs/physics_settings/shipped_it12/shipped_x+.json.gz")},
     other_seeds=[other_seed(s) for s in (1, 2) if os.path.exists(f"{D}/x+/clone_s{s}_test.json")],
+    seeds_pooled_test="the rule's 120 held-out trials, clone seeds 0 / 1 / 2: 15.0 / 6.7 / 11.7% (40 of 360, 11.1% "
+                      "[8.3-14.8]); paired against the replaced clone +13.3 [+6.4, +21.0], +5.0 [-0.4, +11.1], +10.0 "
+                      "[+3.6, +17.1]; seed 0, the only one run before shipping, is the best of the three",
     replaced_because="on the rule's 120 held-out trials (paired by trial) it does 15.0% [9.7-22.5] against the "
                      "replaced clone's 1.7% [0.5-5.9]: +13.3 points [+6.4, +21.0]",
     replaced=old,
