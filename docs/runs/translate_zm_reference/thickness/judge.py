@@ -19,18 +19,26 @@ sys.path.insert(0, STAGE)
 from judge import counts as cells  # noqa: E402  (the cells of a seed_cells.py output: (successes, n) by name)
 
 
-def main():
-    new, old = cells(sys.argv[1]), cells(SHIPPED)
-    expert = read_results(os.path.join(HERE, "clone_s0", "report_test.json"))["summaries"]["translate"]
+def judge(new_path, shipped_path, expert_path, skill, mode):
+    """Print the cells of ``new_path`` against those of ``shipped_path`` (seed_cells.py outputs) and return whether
+    every cell passes: ``mode`` within 5 points of the expert's cell (an eval JSON of ``skill``), every other cell no
+    more than 5 points below the shipped student's."""
+    new, old = cells(new_path), cells(shipped_path)
+    expert = read_results(expert_path)["summaries"][skill]
     ok = True
     print(f"{'cell':20s} {'new student':>14s} {'shipped student':>16s}  bar")
     for k, (s, n) in new.items():
         sr, old_sr = 100.0 * s / n, 100.0 * old[k][0] / old[k][1]
-        bar = expert["sr"] - 5.0 if k == "translate_z-" else old_sr - 5.0
+        bar = expert["sr"] - 5.0 if k == mode else old_sr - 5.0
         passed = sr >= bar - 1e-9
         ok &= passed
         print(f"{k:20s} {sr:6.1f} ({s:>3d}/{n}) {old_sr:7.1f} ({old[k][0]:>3d}/{old[k][1]})  >= {bar:5.1f} "
-              f"{'ok' if passed else 'MISSED'}{'  (the expert: %.1f)' % expert['sr'] if k == 'translate_z-' else ''}")
+              f"{'ok' if passed else 'MISSED'}{'  (the expert: %.1f)' % expert['sr'] if k == mode else ''}")
+    return ok
+
+
+def main():
+    ok = judge(sys.argv[1], SHIPPED, os.path.join(HERE, "clone_s0", "report_test.json"), "translate", "translate_z-")
     print(f"step 6: {'PASSED' if ok else 'FAILED'}")
     return 0 if ok else 1
 
