@@ -1,10 +1,12 @@
 """DAgger: the trainer refuses to start without every expert; a real tiny run lowers the
 student's action MSE to the experts on held-out states of every mode."""
+import copy
+
 import pytest
 import torch
 
 from unicross import formulation as F
-from unicross.rl.dagger import DAggerTrainer, expert_paths
+from unicross.rl.dagger import DAggerTrainer, expert_paths, mode_weight_vector
 from unicross.rl.env import ManiSkillEnv
 from unicross.rl.ppo import PPOTrainer
 
@@ -197,6 +199,50 @@ def test_dagger_starts_from_a_student_and_learns_around_its_states(tmp_path, exp
         assert all(torch.equal(v, before[k]) for k, v in t.actor.named_parameters())
         assert "loss" in t.train(epochs=1)
         assert not all(torch.equal(v, before[k]) for k, v in t.actor.named_parameters())
+    finally:
+        t.close()
+
+
+def test_mode_weights_weigh_each_rows_error_by_its_mode():
+    """optim.mode_weights: the weight vector follows F.MODES (1 where unnamed), typos and non-positive weights
+    are refused; the loss is the weighted mean of the rows' errors (with no weights: the plain mean)."""
+    w = mode_weight_vector({"rotate_x+": 10, "grasp": 0.5})
+    assert w[F.MODES.index("rotate_x+")] == 10 and w[F.MODES.index("grasp")] == 0.5
+    assert int((w == 1).sum()) == F.NUM_MODES - 2
+    assert torch.equal(mode_weight_vector({}), torch.ones(F.NUM_MODES))
+    with pytest.raises(ValueError, match="unknown mode"):
+        mode_weight_vector({"rotate_x": 2})
+    for bad in (0, -1, float("inf"), True, "2"):
+        with pytest.raises(ValueError, match="positive finite"):
+            mode_weight_vector({"grasp": bad})
+
+
+def test_weighted_update_moves_the_student_toward_the_weighted_mode(tmp_path, experts):
+    """One update on a batch of two modes with the same rows: weighting one mode 100x makes the step lower that
+    mode's error more than the unweighted step does."""
+    cfg = _tiny_cfg(grad_steps=1)
+    t = DAggerTrainer(tmp_path / "run", experts, overrides=cfg, progress=False)
+    try:
+        t.collect()
+        b = t.rb[: len(t.rb)]
+        start = {k: v.detach().clone() for k, v in t.actor.state_dict().items()}
+        opt = copy.deepcopy(t.optim.state_dict())
+        errs = {}
+        for weights in ({}, {"rotate_x+": 100.0}):
+            t.actor.load_state_dict(start)
+            t.optim.load_state_dict(opt)
+            t.mode_weights = mode_weight_vector(weights)
+            half = b.batch_size[0] // 2
+            batch = b.clone()
+            batch["mode"][:half] = F.MODES.index("rotate_x+")
+            batch["mode"][half:] = F.MODES.index("grasp")
+            batch["expert_action"][:half] = 1.0  # the x+ rows ask for far-away actions
+            t.rb.sample = lambda batch=batch: batch
+            t.update()
+            with torch.no_grad():
+                pred = t.actor(batch.select("hand", "object", "goal"))["loc"][:half]
+            errs[bool(weights)] = float(((pred - 1.0) ** 2).mean())
+        assert errs[True] < errs[False]
     finally:
         t.close()
 

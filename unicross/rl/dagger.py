@@ -85,6 +85,21 @@ def chain_envs(multi_kwargs: dict, share: float) -> list:
     return [("UniCross-Chain-v1", dict(kw, sequence=["grasp", "relocate", m])) for m in tails]
 
 
+def mode_weight_vector(weights: Optional[Dict[str, float]], device=None) -> torch.Tensor:
+    """``optim.mode_weights``: ``{mode: w}`` as a weight per mode index (``F.MODES`` order, 1 where not named); each
+    row's squared action error counts ``w`` times in the batch's weighted mean. Refuses unknown modes and weights
+    that are not positive numbers."""
+    weights = dict(weights or {})
+    unknown = sorted(set(weights) - set(F.MODES))
+    if unknown:
+        raise ValueError(f"optim.mode_weights: unknown mode(s) {unknown}; modes: {list(F.MODES)}")
+    bad = {m: w for m, w in weights.items()
+           if isinstance(w, bool) or not isinstance(w, (int, float)) or not w > 0 or w == float("inf")}
+    if bad:
+        raise ValueError(f"optim.mode_weights: weights are positive finite numbers, got {bad}")
+    return torch.tensor([float(weights.get(m, 1.0)) for m in F.MODES], device=device)
+
+
 class Teachers(torch.nn.Module):
     """The frozen experts; labels a batch by each state's mode (read from g's one-hot)."""
 
@@ -163,6 +178,7 @@ class DAggerTrainer(Runner):
         unknown = sorted(set(cfg["optim"].get("label_noise_modes") or []) - set(F.MODES))
         if unknown:
             raise ValueError(f"optim.label_noise_modes: unknown mode(s) {unknown}; modes: {list(F.MODES)}")
+        self.mode_weights = mode_weight_vector(cfg["optim"].get("mode_weights"), self.device)
         start = None  # model.init_policy: read and checked before any worker starts
         if self.ckpt is None and cfg["model"].get("init_policy"):
             start = policy_to_start_from(cfg["model"]["init_policy"], "multi", None, self.teachers.hand)
@@ -274,7 +290,7 @@ class DAggerTrainer(Runner):
         return stats
 
     def update(self) -> dict:
-        """``grad_steps`` MSE steps on replay batches. Returns the mean loss, and the MSE overall and per
+        """``grad_steps`` MSE steps on replay batches (rows weighted by ``optim.mode_weights``). Returns the mean loss, and the MSE overall and per
         mode on the batches' stored states (with ``optim.label_noise``: on the rows left as stored, and
         ``mse_perturbed`` on the others)."""
         oc = self.cfg["optim"]
@@ -295,7 +311,8 @@ class DAggerTrainer(Runner):
                 target[moved] = self.teachers(obs[moved])
             pred = self.actor(obs)["loc"]
             err = ((pred - target) ** 2).mean(-1)
-            loss = err.mean()
+            w = self.mode_weights[b["mode"]]
+            loss = (w * err).sum() / w.sum()  # with every weight 1: err.mean(), the paper's loss
             self.optim.zero_grad(set_to_none=True)
             loss.backward()
             self.optim.step()
