@@ -54,6 +54,26 @@ def test_clock_window_and_state_trigger_per_env():
     assert torch.equal(a[1], index) and torch.equal(a[2], torch.zeros_like(index))
 
 
+def test_a_base_term_moves_the_fingers_first_joint_alone():
+    """``finger:base:rate``: the closing direction leaves the first joints still (finger:4 and finger:3 act alike
+    there); a base term moves that joint alone, rate rad per step along its axis, either way."""
+    u = _env(1)
+    spec = u.hand_spec
+    assert parse_sequence("thumb:base:0.01:0:5")[0].base
+    policy = make_sequence_policy("thumb:base:0.01:0:5+index:base:-0.01:0:5")
+    a = policy(None, u)[0]
+    scales = torch.as_tensor(spec.action_scales(), dtype=torch.float32)
+    thumb0 = 6 + spec.finger_joints.index(spec.fingers["thumb"][0])
+    index0 = 6 + spec.finger_joints.index(spec.fingers["index"][0])
+    assert a[thumb0] == pytest.approx(0.01 / float(scales[thumb0]))
+    assert a[index0] == pytest.approx(-0.01 / float(scales[index0]))
+    assert int((a != 0).sum()) == 2
+    whole, distal = finger_sweep_action(spec, 0.01, ("thumb", 4)), finger_sweep_action(spec, 0.01, ("thumb", 3))
+    assert torch.equal(whole, distal) and whole[thumb0] == 0  # why base exists
+    with pytest.raises(ValueError, match="k \\(or base\\)"):
+        parse_sequence("thumb:bass:0.01:0:5")
+
+
 def test_eval_cli_runs_a_sequence_as_run_protocol_does(tmp_path):
     """``unicross eval --policy seq:SPEC`` (worker processes resolve the spec) gives the trials of the
     sequence policy run in-process, as docs/runs/translate_zm_reference/finger_sequences.py runs it."""

@@ -10,6 +10,10 @@ A sequence is a ``+``-joined list of terms ``finger:k:rate:START:END``: the ``k`
   distal joint has reached ``theta`` rad, to the episode's end (a state trigger: the command is part
   of the observation's s^h, so a network can represent the switch).
 
+A term may name ``base`` for ``k``: ``finger:base:rate:...`` moves only the finger's first joint from the palm (the
+Allegro fingers' spread joints, its thumb's rotation), which the closing direction leaves still, ``rate`` rad per
+control step along that joint's own axis (negative: the other way).
+
 Translate z- example (``docs/runs/translate_zm_reference/``): ``index:2:0.05:0:400+ring:2:0.05:@index:0.9``
 curls the index finger's two distal joints (the shipped physical reference) and, once the index's
 distal command has reached 0.9 rad, the ring finger's too. Per-env batched: each env has its own
@@ -39,6 +43,7 @@ class Sweep:
     t1: int = 0
     trigger: Optional[str] = None  # finger whose most distal command starts the sweep
     theta: float = 0.0             # ... once it has reached theta rad
+    base: bool = False             # the finger's first joint alone, along its own axis (``k`` is then 1)
 
 
 _SWITCH = re.compile(r"width<([^?]*)\?([^|]*)\|([^|]*)")
@@ -81,14 +86,15 @@ def parse_sequence(spec: str) -> List[Sweep]:
         if len(parts) != 5:
             raise ValueError(f"sequence term {term!r}: write finger:k:rate:t0:t1 or finger:k:rate:@finger:theta")
         finger, k, rate, start, end = parts
+        base = k == "base"
         try:
-            k_, rate_ = int(k), float(rate)
+            k_, rate_ = 1 if base else int(k), float(rate)
             if start.startswith("@"):
-                sweeps.append(Sweep(finger, k_, rate_, trigger=start[1:], theta=float(end)))
+                sweeps.append(Sweep(finger, k_, rate_, trigger=start[1:], theta=float(end), base=base))
             else:
-                sweeps.append(Sweep(finger, k_, rate_, t0=int(start), t1=int(end)))
+                sweeps.append(Sweep(finger, k_, rate_, t0=int(start), t1=int(end), base=base))
         except ValueError:
-            raise ValueError(f"sequence term {term!r}: k and the window must be integers, rate and theta "
+            raise ValueError(f"sequence term {term!r}: k (or base) and the window must be integers, rate and theta "
                              f"numbers") from None
         if k_ < 1:
             raise ValueError(f"sequence term {term!r}: k (joints moved) must be >= 1")
@@ -109,11 +115,22 @@ def check_sequence(spec: str, hand_spec) -> List[Sweep]:
     return sweeps
 
 
+def sweep_action(hand_spec, s: Sweep) -> torch.Tensor:
+    """The normalised action [dof] of one sweep: :func:`unicross.audit.finger_sweep_action` for ``k`` distal joints;
+    for ``base``, ``rate`` rad per step on the finger's first joint alone (clipped to the action's range)."""
+    from unicross.audit import finger_sweep_action
+    if not s.base:
+        return finger_sweep_action(hand_spec, s.rate, (s.finger, s.k))
+    a = torch.zeros(hand_spec.dof)
+    j = 6 + hand_spec.finger_joints.index(hand_spec.fingers[s.finger][0])
+    a[j] = max(-1.0, min(1.0, s.rate / float(hand_spec.action_scales()[j])))
+    return a
+
+
 def make_sequence_policy(spec: str):
     """A policy ``(obs, env) -> action [n, dof]`` that sums the sweeps of ``spec`` active at each env's
     control step (see the module docstring); triggers latch per env and clear at its step 0. A switched
     spec runs each env's branch by its object's :func:`cross_width`."""
-    from unicross.audit import finger_sweep_action
     parse_sequence(spec)  # a malformed spec fails before any simulation
     switch = split_switch(spec)
     if switch is not None:
@@ -125,7 +142,7 @@ def make_sequence_policy(spec: str):
             sweeps = check_sequence(spec, u.hand_spec)
             terms = []
             for s in sweeps:
-                a = finger_sweep_action(u.hand_spec, s.rate, (s.finger, s.k)).to(u.device)
+                a = sweep_action(u.hand_spec, s).to(u.device)
                 j = (6 + u.hand_spec.finger_joints.index(u.hand_spec.fingers[s.trigger][-1])) if s.trigger else None
                 terms.append((a, s, j))
             cache.update(env=u, terms=terms,
