@@ -7,6 +7,9 @@ of its mode (query rate 100%); the (observation, expert action) pairs go to a Te
 buffer (``LazyTensorStorage``, capacity 1e6 by default); the student then takes
 ``grad_steps`` MSE steps on sampled batches (once ``optim.warmup_frames`` rows are stored; 0 by default).
 
+``optim.mode_weights`` (ours, none by default) counts a mode's rows w times in the batch's weighted mean error, for a
+teacher whose actions are small (the rotate x+ finger sequence).
+
 ``env.chain_share`` (ours, 0 by default): that share of the workers' episodes runs in long-horizon
 chains (grasp, relocate, an in-hand mode; :func:`chain_envs`) instead, labelled phase by phase.
 
@@ -290,9 +293,9 @@ class DAggerTrainer(Runner):
         return stats
 
     def update(self) -> dict:
-        """``grad_steps`` MSE steps on replay batches (rows weighted by ``optim.mode_weights``). Returns the mean loss, and the MSE overall and per
-        mode on the batches' stored states (with ``optim.label_noise``: on the rows left as stored, and
-        ``mse_perturbed`` on the others)."""
+        """``grad_steps`` MSE steps on replay batches (rows weighted by ``optim.mode_weights``). Returns the mean
+        loss, and the MSE overall and per mode on the batches' stored states (with ``optim.label_noise``: on the rows
+        left as stored, and ``mse_perturbed`` on the others)."""
         oc = self.cfg["optim"]
         noise = float(oc.get("label_noise") or 0.0)
         total, clean, noisy = 0.0, 0.0, 0.0
