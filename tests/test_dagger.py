@@ -204,8 +204,8 @@ def test_dagger_starts_from_a_student_and_learns_around_its_states(tmp_path, exp
 
 
 def test_mode_weights_weigh_each_rows_error_by_its_mode():
-    """optim.mode_weights: the weight vector follows F.MODES (1 where unnamed), typos and non-positive weights
-    are refused; the loss is the weighted mean of the rows' errors (with no weights: the plain mean)."""
+    """optim.mode_weights: the weight vector follows F.MODES (1 where unnamed, all ones with no weights); typos and
+    weights that are not positive finite numbers are refused."""
     w = mode_weight_vector({"rotate_x+": 10, "grasp": 0.5})
     assert w[F.MODES.index("rotate_x+")] == 10 and w[F.MODES.index("grasp")] == 0.5
     assert int((w == 1).sum()) == F.NUM_MODES - 2

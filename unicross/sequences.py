@@ -115,6 +115,12 @@ def check_sequence(spec: str, hand_spec) -> List[Sweep]:
     return sweeps
 
 
+def _action_index(hand_spec, finger: str, i: int) -> int:
+    """The action dimension of ``finger``'s joint ``i`` (0: its first from the palm, -1: its most distal), after
+    the 6 wrist dimensions."""
+    return 6 + hand_spec.finger_joints.index(hand_spec.fingers[finger][i])
+
+
 def sweep_action(hand_spec, s: Sweep) -> torch.Tensor:
     """The normalised action [dof] of one sweep: :func:`unicross.audit.finger_sweep_action` for ``k`` distal joints;
     for ``base``, ``rate`` rad per step on the finger's first joint alone (clipped to the action's range)."""
@@ -122,7 +128,7 @@ def sweep_action(hand_spec, s: Sweep) -> torch.Tensor:
     if not s.base:
         return finger_sweep_action(hand_spec, s.rate, (s.finger, s.k))
     a = torch.zeros(hand_spec.dof)
-    j = 6 + hand_spec.finger_joints.index(hand_spec.fingers[s.finger][0])
+    j = _action_index(hand_spec, s.finger, 0)
     a[j] = max(-1.0, min(1.0, s.rate / float(hand_spec.action_scales()[j])))
     return a
 
@@ -143,7 +149,7 @@ def make_sequence_policy(spec: str):
             terms = []
             for s in sweeps:
                 a = sweep_action(u.hand_spec, s).to(u.device)
-                j = (6 + u.hand_spec.finger_joints.index(u.hand_spec.fingers[s.trigger][-1])) if s.trigger else None
+                j = _action_index(u.hand_spec, s.trigger, -1) if s.trigger else None
                 terms.append((a, s, j))
             cache.update(env=u, terms=terms,
                          on=torch.zeros(u.num_envs, len(terms), dtype=torch.bool, device=u.device))

@@ -20,6 +20,7 @@ MSE and per-mode success rates are logged.
 """
 from __future__ import annotations
 
+import math
 import os
 import shutil
 import time
@@ -97,7 +98,7 @@ def mode_weight_vector(weights: Optional[Dict[str, float]], device=None) -> torc
     if unknown:
         raise ValueError(f"optim.mode_weights: unknown mode(s) {unknown}; modes: {list(F.MODES)}")
     bad = {m: w for m, w in weights.items()
-           if isinstance(w, bool) or not isinstance(w, (int, float)) or not w > 0 or w == float("inf")}
+           if isinstance(w, bool) or not isinstance(w, (int, float)) or not (w > 0 and math.isfinite(w))}
     if bad:
         raise ValueError(f"optim.mode_weights: weights are positive finite numbers, got {bad}")
     return torch.tensor([float(weights.get(m, 1.0)) for m in F.MODES], device=device)
