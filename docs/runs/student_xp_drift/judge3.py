@@ -7,23 +7,16 @@ The experts' cells are docs/results.md's (50th session), copied into EXPERT belo
 read from docs/runs/translate_zm_reference/thickness/student_cells_seed0.json (the cells docs/results.md shows for it).
 """
 import json
-import math
 import os
 import sys
+
+from unicross.metrics import wilson_interval
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 RUNS = os.path.join(HERE, "..")
 # the shipped experts' test cells in docs/results.md (success rates, %)
 EXPERT = {"grasp": 100.0, "relocate": 100.0, "rotate_x+": 24.0, "rotate_x-": 8.0, "rotate_y+": 43.0,
           "rotate_y-": 53.0, "rotate_z+": 55.0, "rotate_z-": 1.0, "translate_z+": 98.0, "translate_z-": 87.0}
-
-
-def wilson(k, n, z=1.96):
-    p = k / n
-    d = 1 + z * z / n
-    c = (p + z * z / (2 * n)) / d
-    h = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / d
-    return 100 * (c - h), 100 * (c + h)
 
 
 def pooled(files):
@@ -48,7 +41,7 @@ if __name__ == "__main__":
     print("|---|" + "---|" * len(cells) + "---|---|---|")
     for name, (k, n) in pool.items():
         sr = 100 * k / n
-        lo, hi = wilson(k, n)
+        lo, hi = (100 * x for x in wilson_interval(k, n))
         if name in EXPERT:
             bar = EXPERT[name] - 5
             per = [c["test"][name]["summary"]["sr"] for c in cells]
