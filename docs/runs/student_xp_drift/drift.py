@@ -26,6 +26,9 @@ p.add_argument("--seed", type=int, default=0)
 p.add_argument("--bias-from", default=None, help="a drift.py output: add its trials' mean action error after the stop "
                "(16 finger joints, action units) to POLICY's action after the stop (a causal check: does that bias "
                "alone make the expert drop?)")
+p.add_argument("--deadband", type=float, default=0.0, help="zero every finger action of POLICY smaller than this in "
+               "magnitude (action units), at every step (a diagnostic: does removing small steady actions stop the "
+               "drift, and what does it cost?)")
 args = p.parse_args()
 
 act_fn, _ = resolve_policy(args.policy, "allegro")
@@ -43,6 +46,10 @@ if args.bias_from:
 
 def policy(obs, u):
     a = act_fn(obs, u)
+    if args.deadband > 0:
+        a = a.clone()
+        small = a[:, FINGERS].abs() < args.deadband
+        a[:, FINGERS] = torch.where(small, torch.zeros_like(a[:, FINGERS]), a[:, FINGERS])
     if bias is not None and bool(u.command[0, THUMB_DIP] >= 0.5):
         a = a.clone()
         a[0, FINGERS] += bias.to(a)
@@ -80,7 +87,7 @@ chosen, _ = protocol_objects("rotate", get_object_set(args.objects, limit=args.l
 run_protocol("rotate", policy, chosen, trials_per_object=args.trials, seed=args.seed, axes=["x+"], progress=False)
 n = len(per_trial)
 stopped = [t for t in per_trial if t["t_stop"] is not None]
-summ = dict(policy=args.policy, bias_from=args.bias_from, objects=args.objects, limit=args.limit, trials=args.trials, seed=args.seed, n=n, successes=sum(t["success"] for t in per_trial),
+summ = dict(policy=args.policy, bias_from=args.bias_from, deadband=args.deadband, objects=args.objects, limit=args.limit, trials=args.trials, seed=args.seed, n=n, successes=sum(t["success"] for t in per_trial),
             dropped=sum(t["dropped"] for t in per_trial), reached_stop=len(stopped),
             mean_t_stop=sum(t["t_stop"] for t in stopped) / max(1, len(stopped)),
             mse_before=sum(t["mse_before"] for t in per_trial if t["mse_before"] is not None) / n,
