@@ -12,6 +12,7 @@ import json
 import torch
 
 import unicross.evaluation as E
+from band import zero_small_finger_actions
 from unicross import formulation as F
 from unicross.report import PaperReport
 
@@ -22,17 +23,11 @@ p.add_argument("out")
 p.add_argument("--modes", nargs="*", default=list(F.MODES))
 p.add_argument("--chain", action="store_true")
 args = p.parse_args()
-FINGERS = slice(6, None)
 _resolve = E.resolve_policy
 
 
 def banded(fn):
-    def policy(obs, u):
-        a = fn(obs, u).clone()
-        f = a[:, FINGERS]
-        a[:, FINGERS] = torch.where(f.abs() < args.band, torch.zeros_like(f), f)
-        return a
-    return policy
+    return lambda obs, u: zero_small_finger_actions(fn(obs, u), args.band)
 
 
 def resolve(spec, hand, seed=0):

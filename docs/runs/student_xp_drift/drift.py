@@ -13,6 +13,7 @@ import json
 import torch
 
 import unicross.evaluation as E
+from band import zero_small_finger_actions
 from unicross.evaluation import protocol_objects, resolve_policy, run_protocol
 from unicross.objects import get_object_set
 
@@ -47,9 +48,7 @@ if args.bias_from:
 def policy(obs, u):
     a = act_fn(obs, u)
     if args.deadband > 0:
-        a = a.clone()
-        small = a[:, FINGERS].abs() < args.deadband
-        a[:, FINGERS] = torch.where(small, torch.zeros_like(a[:, FINGERS]), a[:, FINGERS])
+        a = zero_small_finger_actions(a, args.deadband)
     if bias is not None and bool(u.command[0, THUMB_DIP] >= 0.5):
         a = a.clone()
         a[0, FINGERS] += bias.to(a)
