@@ -1,6 +1,20 @@
-"""Offline polish diagnostic: per-mode held-out MSE on a DAgger run's replay buffer, constant lr vs annealed."""
-import sys, json, math, time, copy, torch
-from torchrl.data import TensorDictReplayBuffer, LazyTensorStorage, Bounded
+"""Offline polish (a diagnostic): more Adam steps on a DAgger run's replay buffer, 10% of its rows held out of the fit.
+
+    python docs/runs/student_buffer1m/polish.py RUN STEPS LR cos|const [OUT.pt]
+
+Prints the student's per-mode MSE on the held-out rows at the start and after each quarter of STEPS (batch 1024, rows
+weighted by the run's optim.mode_weights, lr LR constant or cosine to 0); OUT.pt: the run's checkpoint with the
+polished weights (for drift.py or seed_cells.py). The held-out rows come from the same (object, mode) pairs as the
+fitted ones: this measures the fit of the buffer, not what the student meets on new objects.
+"""
+import json
+import math
+import sys
+import time
+
+import torch
+from torchrl.data import Bounded, LazyTensorStorage, TensorDictReplayBuffer
+
 from unicross.rl.models import make_models, OBS_KEYS
 from unicross import formulation as F
 from unicross.rl.dagger import mode_weight_vector
