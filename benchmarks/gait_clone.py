@@ -48,13 +48,16 @@ from unicross import formulation as F
 def _rollouts(gait: str, hand: str, objects: str, limit: int, trials: int, seed: int, randomize: bool,
               student, shard, beta: float = 0.0, privileged_q0: bool = False, clock: bool = False,
               history: int = 0, sequence: str = None, mode: str = None, grasps: str = None,
-              accumulated: bool = False, sim: dict = None) -> tuple:
+              accumulated: bool = False, sim: dict = None, drift: float = 0.0) -> tuple:
     """One worker's share: (obs dict of [N, d], labels [N, A], trials) of the protocol of the gait's mode
     on its objects, the gait acting (``student`` None) or the student's mean acting while the gait labels
     (with ``sequence``, a finger sequence of :mod:`unicross.sequences` on ``mode``'s protocol instead);
     with ``beta`` > 0 the gait's own action is taken instead at that fraction of the steps (each env
     and step drawn on its own: DAgger's mixture policy). ``grasps``: the grasp-state dataset the episodes
-    start from (None: the hand's shipped one). ``sim``: physics overrides of ``configs/task.yaml``'s ``sim``."""
+    start from (None: the hand's shipped one). ``sim``: physics overrides of ``configs/task.yaml``'s ``sim``.
+    ``drift`` > 0 (with a ``student``): each episode draws one constant offset per finger action, Gaussian with this
+    std (action units), added to every action the episode takes, so the states drift as a student's small steady
+    bias drifts them; the labels stay the teacher's."""
     torch.set_num_threads(1)
     import unicross  # noqa: F401  (registers the tasks)
     from unicross import evaluation as E
@@ -73,6 +76,7 @@ def _rollouts(gait: str, hand: str, objects: str, limit: int, trials: int, seed:
     rows = {k: [] for k in keys}
     labels = []
     mix = torch.Generator().manual_seed(seed + 104729 * shard[0])
+    offset = {}
 
     q0 = {}
     prev = {}
@@ -108,6 +112,11 @@ def _rollouts(gait: str, hand: str, objects: str, limit: int, trials: int, seed:
         if beta > 0:
             gait_steps = torch.rand(act.shape[0], 1, generator=mix) < beta
             act = torch.where(gait_steps, label, act)
+        if drift > 0:
+            if int(u.elapsed_steps[0]) == 0:
+                offset["a"] = torch.zeros_like(act)
+                offset["a"][:, 6:] = drift * torch.randn(act.shape[0], act.shape[1] - 6, generator=mix)
+            act = (act + offset["a"]).clamp(-1.0, 1.0)
         return act
 
     out = E.run_protocol(skill, policy, get_object_set(objects, limit=limit), hand=hand, trials_per_object=trials,
@@ -152,6 +161,10 @@ def main(argv=None) -> int:
                     help="diagnosis only: the network also sees the motion accumulated along the axis so far over the "
                          "success threshold (what a gait's stop reads; a memory of the episode the observation lacks); "
                          "its checkpoint does not fit the UniCross observation and is not written")
+    ap.add_argument("--drift", type=float, default=0.0, metavar="SIGMA",
+                    help="in the rounds the network acts (not the last, which measures it): a constant offset per "
+                         "finger action and episode, N(0, SIGMA^2) in action units, added to the actions taken, so the "
+                         "data holds the teacher's labels on states a student's small steady bias drifts to (0: none)")
     ap.add_argument("--randomize", action="store_true", help="training's randomisation (default: the evaluation's conditions)")
     ap.add_argument("--grasps", default=None, help="grasp-state dataset the episodes start from (default: the shipped one)")
     ap.add_argument("--heldout", type=int, default=0, metavar="LIMIT",
@@ -216,18 +229,19 @@ def main(argv=None) -> int:
     def beta_of(r: int) -> float:  # the last round measures the network alone
         return 0.0 if r in (0, args.rounds) else args.beta ** r
 
-    def collect(objects: str, limit: int, trials: int, seed: int, randomize: bool, student, beta: float) -> list:
+    def collect(objects: str, limit: int, trials: int, seed: int, randomize: bool, student, beta: float,
+                drift: float = 0.0) -> list:
         """Every worker's :func:`_rollouts` of one round (or of the held-out evaluation)."""
         with ProcessPoolExecutor(args.workers, mp_context=ctx) as ex:
             return [f.result() for f in [ex.submit(_rollouts, args.gait, args.hand, objects, limit, trials, seed,
                                                     randomize, student, (i, args.workers), beta, args.privileged_q0,
                                                     args.clock, args.history, args.sequence, mode, args.grasps,
-                                                    args.progress, sim)
+                                                    args.progress, sim, drift)
                                           for i in range(args.workers)]]
 
     for r in range(args.rounds + 1):
         parts = collect(args.objects, args.limit, args.trials, args.seed + 7919 * r, args.randomize,
-                        None if r == 0 else actor, beta_of(r))
+                        None if r == 0 else actor, beta_of(r), 0.0 if r == args.rounds else args.drift)
         o = {k: torch.cat([p[0][k] for p in parts]) for k in parts[0][0]}
         y = torch.cat([p[1] for p in parts])
         trials = [t for p in parts for t in p[2]]
