@@ -4,7 +4,8 @@ expert's stop (the thumb's distal command past 0.5 rad, where the sequence it cl
 
     python docs/runs/student_xp_drift/drift.py POLICY OUT.json [--limit 5 --trials 2]
 
-POLICY is what acts (a student checkpoint, or allegro/rotate_x+ itself); the labeller is always allegro/rotate_x+.
+POLICY is what acts (a student checkpoint, or allegro/rotate_x+ itself); the labeller is allegro/rotate_x+ unless
+`--labeller` names another x+ policy.
 The rotate protocol's x+ trials (seeded as `unicross eval`) on `--objects` (test: held out; train: for choosing).
 """
 import argparse
@@ -24,6 +25,8 @@ p.add_argument("--limit", type=int, default=5)
 p.add_argument("--trials", type=int, default=2)
 p.add_argument("--objects", default="test", help="test (held out) or train (for choosing)")
 p.add_argument("--seed", type=int, default=0)
+p.add_argument("--labeller", default="allegro/rotate_x+", help="the policy whose action labels each step (default: the "
+               "shipped x+ expert)")
 p.add_argument("--bias-from", default=None, help="a drift.py output: add its trials' mean action error after the stop "
                "(16 finger joints, action units) to POLICY's action after the stop (a causal check: does that bias "
                "alone make the expert drop?)")
@@ -33,7 +36,7 @@ p.add_argument("--deadband", type=float, default=0.0, help="zero every finger ac
 args = p.parse_args()
 
 act_fn, _ = resolve_policy(args.policy, "allegro")
-label_fn, _ = resolve_policy("allegro/rotate_x+", "allegro")
+label_fn, _ = resolve_policy(args.labeller, "allegro")
 THUMB_DIP = 6 + 15          # joint_15.0, the thumb's distal joint (the sequence's trigger)
 FINGERS = slice(6, 22)
 rows = []                   # per step of the current trial: (command[16], action[16], label[16])
@@ -86,7 +89,7 @@ chosen, _ = protocol_objects("rotate", get_object_set(args.objects, limit=args.l
 run_protocol("rotate", policy, chosen, trials_per_object=args.trials, seed=args.seed, axes=["x+"], progress=False)
 n = len(per_trial)
 stopped = [t for t in per_trial if t["t_stop"] is not None]
-summ = dict(policy=args.policy, bias_from=args.bias_from, deadband=args.deadband, objects=args.objects, limit=args.limit, trials=args.trials, seed=args.seed, n=n, successes=sum(t["success"] for t in per_trial),
+summ = dict(policy=args.policy, labeller=args.labeller, bias_from=args.bias_from, deadband=args.deadband, objects=args.objects, limit=args.limit, trials=args.trials, seed=args.seed, n=n, successes=sum(t["success"] for t in per_trial),
             dropped=sum(t["dropped"] for t in per_trial), reached_stop=len(stopped),
             mean_t_stop=sum(t["t_stop"] for t in stopped) / max(1, len(stopped)),
             mse_before=sum(t["mse_before"] for t in per_trial if t["mse_before"] is not None) / n,
