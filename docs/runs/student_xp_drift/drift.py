@@ -77,6 +77,7 @@ def score(*a, **k):
                bias_after=err[after].mean(0).tolist() if bool(after.any()) else None,
                drift_after=((cmd[-1] - cmd[t_stop]).tolist() if t_stop is not None else None),
                label_abs_after=float(lab[after].abs().mean()) if bool(after.any()) else None,
+               label_wild_after=float((lab[after].abs().amax(-1) > 0.2).float().mean()) if bool(after.any()) else None,
                final_cmd=cmd[-1].tolist())
     rows.clear()
     per_trial.append(out)
