@@ -208,6 +208,8 @@ def main(argv=None) -> int:
         ap.error(str(e))
     if sim:
         cfg["env"]["task_config"] = dict(cfg["env"].get("task_config") or {}, sim=sim)
+    if args.drift < 0:
+        ap.error("--drift must be >= 0")
     if args.obs_std_min is not None:
         if args.obs_std_min < 0:
             ap.error("--obs-std-min must be >= 0")
