@@ -17,6 +17,13 @@ next to each mode's label variance (the error of predicting the mean label)::
 ``--relabel MODE=POLICY`` replaces that mode's labels by another teacher's mean actions on the same
 states (clamped to [-1, 1], as DAgger's teachers label): would the student fit that teacher better?
 
+``--init`` starts from the run's own student (its weights and observation statistics) instead of a fresh one, and
+``--weighted`` weighs the rows as the run did (``optim.mode_weights``): would more steps on the same data polish the
+run's student? ``--out`` writes the run's checkpoint with the fitted weights, for ``unicross eval`` or drift.py::
+
+    python benchmarks/student_fit.py runs/x0_1800 --init --weighted --steps 10000 --lr-floor 0 --threads 2 \
+        --out runs/x0_1800_polished.pt
+
 No simulation: a few minutes on one core for 20k steps of 1024 samples with the default network.
 The held-out samples come from the same rollouts as the fitted ones (a random split), so they
 measure fitting, not the student's own new states (DAgger's fresh error).
@@ -33,6 +40,7 @@ import torch
 from torchrl.data import Bounded, LazyTensorStorage, TensorDictReplayBuffer
 
 from unicross import formulation as F
+from unicross.rl.dagger import mode_weight_vector
 from unicross.rl.models import OBS_KEYS, make_models
 
 
@@ -56,7 +64,12 @@ def main(argv=None) -> int:
     p.add_argument("run", help="a unicross distill run directory (checkpoint.pt and its replay buffer)")
     p.add_argument("--steps", type=int, default=20000)
     p.add_argument("--batch-size", type=int, default=1024)
-    p.add_argument("--lr", type=float, default=3e-4, help="start of the cosine decay (to lr/100)")
+    p.add_argument("--lr", type=float, default=3e-4, help="start of the cosine decay (to lr x --lr-floor)")
+    p.add_argument("--lr-floor", type=float, default=0.01, help="where the cosine decay ends, as a fraction of --lr")
+    p.add_argument("--init", action="store_true", help="start from the run's student (weights and observation "
+                   "statistics) instead of a fresh network")
+    p.add_argument("--weighted", action="store_true", help="weigh the rows by the run's optim.mode_weights")
+    p.add_argument("--out", default=None, help="write the run's checkpoint with the fitted weights here")
     p.add_argument("--holdout", type=float, default=0.1, help="fraction of the buffer held out")
     p.add_argument("--main-hidden", type=int, nargs="+", default=None, help="default: the run's model.main_hidden")
     p.add_argument("--threads", type=int, default=1)
@@ -67,6 +80,10 @@ def main(argv=None) -> int:
     a = p.parse_args(argv)
     if not 0 < a.holdout < 1:
         p.error("--holdout must be in (0, 1)")
+    if not 0 <= a.lr_floor <= 1:
+        p.error("--lr-floor must be in [0, 1]")
+    if a.init and a.main_hidden:
+        p.error("--init keeps the run's network: leave out --main-hidden")
     torch.set_num_threads(a.threads)
     torch.manual_seed(a.seed)
     relabel = {}
@@ -91,11 +108,16 @@ def main(argv=None) -> int:
     dims = {k: data[k].shape[-1] for k in OBS_KEYS}
     n_act = data["expert_action"].shape[-1]
     policy, _, norm = make_models(dims, n_act, Bounded(-1.0, 1.0, (n_act,)), model_cfg)
-    norm.update({k: fit[k] for k in OBS_KEYS})
+    if a.init:
+        policy.load_state_dict(ck["policy"])
+    else:
+        norm.update({k: fit[k] for k in OBS_KEYS})
+    weights = mode_weight_vector(ck["config"]["optim"].get("mode_weights") if a.weighted else None)
     actor = policy.module[0].module
     optim = torch.optim.Adam(actor.parameters(), lr=a.lr)
+    floor = a.lr_floor
     sched = torch.optim.lr_scheduler.LambdaLR(
-        optim, lambda s: 0.01 + 0.99 * 0.5 * (1 + math.cos(math.pi * min(s, a.steps) / a.steps)))
+        optim, lambda s: floor + (1 - floor) * 0.5 * (1 + math.cos(math.pi * min(s, a.steps) / a.steps)))
 
     @torch.no_grad()
     def evaluate(td) -> dict:
@@ -106,11 +128,13 @@ def main(argv=None) -> int:
             errs.append(((loc - b["expert_action"]) ** 2).mean(-1))
         return per_mode(torch.cat(errs), td["mode"])
 
+    before = evaluate(test) if a.init else None
     t0 = time.perf_counter()
     for s in range(a.steps):
         b = fit[torch.randint(fit.shape[0], (a.batch_size,))]
         loc, _ = actor(*(b[k] for k in OBS_KEYS))
-        loss = ((loc - b["expert_action"]) ** 2).mean()
+        w = weights[b["mode"]]
+        loss = (w * ((loc - b["expert_action"]) ** 2).mean(-1)).sum() / w.sum()  # every weight 1: the plain mean
         optim.zero_grad(set_to_none=True)
         loss.backward()
         optim.step()
@@ -127,12 +151,18 @@ def main(argv=None) -> int:
     counts = {m: int((data["mode"] == i).sum()) for i, m in enumerate(F.MODES)}
     for m in held:
         print(f"| {m} | {counts[m]} | {label_var[m]:.4f} | {fitted[m]:.5f} | {held[m]:.5f} |")
+    if before is not None:
+        print("\nheld out before the fit (the run's student): " + ", ".join(f"{m} {v:.2e}" for m, v in before.items()))
+    if a.out:
+        torch.save(dict(ck, policy=policy.state_dict()), a.out)
+        print(f"wrote {a.out}")
     if a.json:
         Path(a.json).parent.mkdir(parents=True, exist_ok=True)
         Path(a.json).write_text(json.dumps(dict(
             run=str(a.run), relabel=relabel, samples=n, held_out=n_test, steps=a.steps, batch_size=a.batch_size, lr=a.lr,
             main_hidden=model_cfg.get("main_hidden"), seed=a.seed, seconds=time.perf_counter() - t0,
-            label_variance=label_var, mse_fitted=fitted, mse_held_out=held, samples_per_mode=counts), indent=1))
+            label_variance=label_var, mse_fitted=fitted, mse_held_out=held, samples_per_mode=counts,
+            init=a.init, weighted=a.weighted, lr_floor=a.lr_floor, mse_held_out_before=before), indent=1))
     return 0
 
 

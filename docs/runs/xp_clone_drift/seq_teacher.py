@@ -13,6 +13,7 @@ observation: phase 1 while that command is under 0.5, 0 from then on. A student 
 the ten shipped checkpoints (the issue's student): nothing it makes is shipped.
 """
 import sys
+from pathlib import Path
 
 import torch
 
@@ -47,11 +48,9 @@ def patch_teachers() -> None:
 
 
 def check(run: str) -> None:
-    from torchrl.data import LazyTensorStorage, TensorDictReplayBuffer
-    ck = torch.load(f"{run}/checkpoint.pt", weights_only=False)
-    rb = TensorDictReplayBuffer(storage=LazyTensorStorage(ck["config"]["buffer"]["capacity"]))
-    rb.loads(f"{run}/{ck['replay_dir']}")
-    data = rb[:len(rb)]
+    sys.path.insert(0, str(Path(__file__).resolve().parents[3] / "benchmarks"))
+    from student_fit import load_buffer
+    data, _ = load_buffer(Path(run))
     sel = data["mode"] == XP
     hand, clone = data["hand"][sel], data["expert_action"][sel]
     seq = sequence_labeller()(hand)
