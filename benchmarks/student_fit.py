@@ -40,7 +40,7 @@ import torch
 from torchrl.data import Bounded, LazyTensorStorage, TensorDictReplayBuffer
 
 from unicross import formulation as F
-from unicross.rl.dagger import mode_weight_vector
+from unicross.rl.dagger import distill_loss, mode_weight_vector
 from unicross.rl.models import OBS_KEYS, make_models
 
 
@@ -76,6 +76,8 @@ def main(argv=None) -> int:
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--relabel", action="append", default=[], metavar="MODE=POLICY",
                    help="label MODE's states with POLICY (a checkpoint or <hand>/<mode>) instead; repeatable")
+    p.add_argument("--l1", type=float, default=0.0, help="add this times the absolute action error to the loss "
+                   "(unicross distill's optim.l1; 0: the plain MSE)")
     p.add_argument("--json", default=None)
     a = p.parse_args(argv)
     if not 0 < a.holdout < 1:
@@ -133,8 +135,7 @@ def main(argv=None) -> int:
     for s in range(a.steps):
         b = fit[torch.randint(fit.shape[0], (a.batch_size,))]
         loc, _ = actor(*(b[k] for k in OBS_KEYS))
-        w = weights[b["mode"]]
-        loss = (w * ((loc - b["expert_action"]) ** 2).mean(-1)).sum() / w.sum()  # every weight 1: the plain mean
+        loss, _ = distill_loss(loc, b["expert_action"], weights[b["mode"]], a.l1)
         optim.zero_grad(set_to_none=True)
         loss.backward()
         optim.step()

@@ -6,7 +6,7 @@ import pytest
 import torch
 
 from unicross import formulation as F
-from unicross.rl.dagger import DAggerTrainer, expert_paths, mode_weight_vector
+from unicross.rl.dagger import DAggerTrainer, distill_loss, expert_paths, mode_weight_vector
 from unicross.rl.env import ManiSkillEnv
 from unicross.rl.ppo import PPOTrainer
 
@@ -215,6 +215,25 @@ def test_mode_weights_weigh_each_rows_error_by_its_mode():
     for bad in (0, -1, float("inf"), True, "2"):
         with pytest.raises(ValueError, match="positive finite"):
             mode_weight_vector({"grasp": bad})
+
+
+def test_distill_loss_l1_keeps_a_gradient_at_small_errors():
+    """optim.l1 = 0 is the weighted MSE; with l1 > 0 the gradient at an error of 1e-3 is l1 / n_act per unit weight
+    (the squared error's alone: 2e-3 / n_act); negative or infinite l1 is refused."""
+    pred = torch.full((4, 2), 1e-3, requires_grad=True)
+    target = torch.zeros(4, 2)
+    w = torch.tensor([1.0, 1.0, 3.0, 1.0])
+    loss, err = distill_loss(pred, target, w)
+    assert torch.allclose(loss, (w * ((pred - target) ** 2).mean(-1)).sum() / w.sum())
+    assert torch.allclose(err, torch.full((4,), 1e-6))
+    (g_mse,) = torch.autograd.grad(loss, pred)
+    loss_l1, _ = distill_loss(pred, target, w, l1=0.01)
+    (g_l1,) = torch.autograd.grad(loss_l1, pred)
+    assert torch.allclose(g_l1 - g_mse, 0.01 / 2 * (w / w.sum())[:, None].expand(4, 2))
+    assert bool((g_l1 > 5 * g_mse).all())  # 6x here: 1e-3 + 5e-3 against 1e-3, per unit weight
+    for bad in (-0.1, float("inf")):
+        with pytest.raises(ValueError, match="optim.l1"):
+            distill_loss(pred, target, w, l1=bad)
 
 
 def test_weighted_update_moves_the_student_toward_the_weighted_mode(tmp_path, experts):
