@@ -40,7 +40,7 @@ import torch
 from torchrl.data import Bounded, LazyTensorStorage, TensorDictReplayBuffer
 
 from unicross import formulation as F
-from unicross.rl.dagger import distill_loss, mode_weight_vector
+from unicross.rl.dagger import check_l1, distill_loss, mode_weight_vector
 from unicross.rl.models import OBS_KEYS, make_models
 
 
@@ -84,6 +84,10 @@ def main(argv=None) -> int:
         p.error("--holdout must be in (0, 1)")
     if not 0 <= a.lr_floor <= 1:
         p.error("--lr-floor must be in [0, 1]")
+    try:
+        check_l1(a.l1)
+    except ValueError as e:
+        p.error(str(e))
     if a.init and a.main_hidden:
         p.error("--init keeps the run's network: leave out --main-hidden")
     torch.set_num_threads(a.threads)

@@ -104,14 +104,20 @@ def mode_weight_vector(weights: Optional[Dict[str, float]], device=None) -> torc
     return torch.tensor([float(weights.get(m, 1.0)) for m in F.MODES], device=device)
 
 
+def check_l1(l1) -> float:
+    """``optim.l1`` as a float; refuses anything but a finite number >= 0."""
+    if isinstance(l1, bool) or not isinstance(l1, (int, float)) or not (l1 >= 0 and math.isfinite(l1)):
+        raise ValueError(f"optim.l1 must be a finite number >= 0, got {l1!r}")
+    return float(l1)
+
+
 def distill_loss(pred: torch.Tensor, target: torch.Tensor, weight: torch.Tensor, l1: float = 0.0):
     """The student's loss on a batch: the rows' squared action errors (mean over the action), in a mean weighted by
     ``weight`` (per row; every weight 1: the paper's MSE), plus ``l1`` times the rows' absolute errors in the same
     mean (``optim.l1``). Near a label the squared error's gradient vanishes with the error, so a student keeps a
     small steady bias where its teachers answer 0 (a finger holding still), and a bias integrates into a drift of
     the commands; the absolute error's gradient does not vanish. Returns (loss, the rows' squared errors)."""
-    if l1 < 0 or not math.isfinite(l1):
-        raise ValueError(f"optim.l1 must be a finite number >= 0, got {l1}")
+    check_l1(l1)
     diff = pred - target
     err = (diff ** 2).mean(-1)
     per_row = err + l1 * diff.abs().mean(-1) if l1 > 0 else err
@@ -197,9 +203,7 @@ class DAggerTrainer(Runner):
         if unknown:
             raise ValueError(f"optim.label_noise_modes: unknown mode(s) {unknown}; modes: {list(F.MODES)}")
         self.mode_weights = mode_weight_vector(cfg["optim"].get("mode_weights"), self.device)
-        l1 = cfg["optim"].get("l1") or 0.0
-        if isinstance(l1, bool) or not isinstance(l1, (int, float)) or not (l1 >= 0 and math.isfinite(l1)):
-            raise ValueError(f"optim.l1 must be a finite number >= 0, got {l1!r}")
+        self.l1 = check_l1(cfg["optim"].get("l1") or 0.0)
         start = None  # model.init_policy: read and checked before any worker starts
         if self.ckpt is None and cfg["model"].get("init_policy"):
             start = policy_to_start_from(cfg["model"]["init_policy"], "multi", None, self.teachers.hand)
@@ -317,7 +321,6 @@ class DAggerTrainer(Runner):
         left as stored, and ``mse_perturbed`` on the others)."""
         oc = self.cfg["optim"]
         noise = float(oc.get("label_noise") or 0.0)
-        l1 = float(oc.get("l1") or 0.0)
         total, clean, noisy = 0.0, 0.0, 0.0
         per_mode, counts = torch.zeros(F.NUM_MODES), torch.zeros(F.NUM_MODES)
         for _ in range(oc["grad_steps"]):
@@ -333,7 +336,7 @@ class DAggerTrainer(Runner):
                 target = target.clone()
                 target[moved] = self.teachers(obs[moved])
             pred = self.actor(obs)["loc"]
-            loss, err = distill_loss(pred, target, self.mode_weights[b["mode"]], l1)
+            loss, err = distill_loss(pred, target, self.mode_weights[b["mode"]], self.l1)
             self.optim.zero_grad(set_to_none=True)
             loss.backward()
             self.optim.step()
