@@ -2,6 +2,9 @@
 expert" per mode and the shipped student's long horizon - 5.
 
     python docs/runs/student_xp_drift/judge3.py student_cells_s0.json student_cells_s1.json student_cells_s2.json
+    python docs/runs/student_xp_drift/judge3.py --expert rotate_x+=CELL.json cells_s0.json ...   # another x+ expert
+
+``--expert MODE=FILE`` replaces that mode's expert cell by FILE's (docs/runs/xp_clone_drift/expert_cell.py's output).
 
 The experts' cells are docs/results.md's (50th session), copied into EXPERT below; the shipped student's long horizon is
 read from docs/runs/translate_zm_reference/thickness/student_cells_seed0.json (the cells docs/results.md shows for it).
@@ -35,7 +38,15 @@ def pooled(files):
 
 if __name__ == "__main__":
     shipped = json.load(open(os.path.join(RUNS, "translate_zm_reference", "thickness", "student_cells_seed0.json")))
-    pool, cells = pooled(sys.argv[1:])
+    args = sys.argv[1:]
+    while args and args[0] == "--expert":
+        mode, path = args[1].split("=", 1)
+        if mode not in EXPERT:
+            sys.exit(f"--expert: unknown mode {mode!r} (one of {', '.join(EXPERT)})")
+        EXPERT[mode] = json.load(open(path))["summary"]["sr"]
+        print(f"{mode}: the expert's cell is {path}'s {EXPERT[mode]:g}")
+        args = args[2:]
+    pool, cells = pooled(args)
     ok = True
     print("| cell | " + " | ".join(f"seed {i}" for i in range(len(cells))) + " | pooled [95% CI] | bar | |")
     print("|---|" + "---|" * len(cells) + "---|---|---|")
