@@ -5,13 +5,12 @@
 set -x
 cd "$(dirname "$0")/../../.."
 source .venv/bin/activate
-D=docs/runs/student_l1
+source docs/runs/student_l1/common.sh
 [ -f runs/student_1204_morning.pt ] || git show e10d371:unicross/checkpoints/allegro/student.pt > runs/student_1204_morning.pt
 for S in 0 1 2; do
   R=runs/l1_w30_s$S
   if [ ! -f $D/student_cells_s$S.json ]; then
-    [ -f $R/checkpoint.pt ] && RES=--resume || RES=
-    unicross distill --experts runs/experts1205x --out $R --epochs 1500 $RES --set model.init_policy=runs/student_1204_morning.pt --set optim.lr=1.0e-4 --set optim.warmup_frames=102400 --set env.object_limit=null --set collector.rollout_steps=256 --set optim.grad_steps=30 --set optim.batch_size=1024 --set buffer.capacity=300000 --set logging.checkpoint_every=25 --set seed=$S --set env.chain_share=0.15 --set 'optim.mode_weights={rotate_x+: 30}' --set optim.l1=0.01 > $R.log 2>&1 || exit 1
+    stage runs/experts1205x $R $S || exit 1
     unicross export $R --out $D/student_l1_s$S.pt || exit 1
     python docs/runs/student_ft_1202b/seed_cells.py $D/student_l1_s$S.pt $D/student_cells_s$S.json > runs/cells_l1_s$S.log 2>&1 || exit 1
   fi

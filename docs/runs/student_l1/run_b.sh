@@ -6,14 +6,14 @@
 set -x
 cd "$(dirname "$0")/../../.."
 source .venv/bin/activate
-D=docs/runs/student_l1
+source docs/runs/student_l1/common.sh
 SEQ='index:4:-0.010:0:1000+thumb:4:0.010:0:1000+index:4:0.010:@thumb:0.5+thumb:4:-0.010:@thumb:0.5'
 for S in 4 5; do
   [ -f runs/xp_b_s$S/policy.pt ] || python benchmarks/gait_clone.py --sequence "$SEQ" --mode rotate_x+ --limit 32 --trials 2 --rounds 6 --beta 0.5 --workers 2 --seed $S --obs-std-min 1e-2 --out runs/xp_b_s$S > runs/xp_b_s$S.log 2>&1 || exit 1
   cp runs/xp_b_s$S/command.txt $D/clone_s${S}_command.txt; cp runs/xp_b_s$S/log.jsonl $D/clone_s${S}_log.jsonl
 done
 for S in 4 5; do
-  [ -f $D/train300_clone_s$S.json ] || (cd $D && python ../student_xp_drift/drift.py ../../../runs/xp_b_s$S/policy.pt train300_clone_s$S.json --objects train --limit 50 --trials 3 --labeller ../../../runs/xp_b_s$S/policy.pt) > runs/drift_b_s$S.log 2>&1 || exit 1
+  [ -f $D/train300_clone_s$S.json ] || screen runs/xp_b_s$S/policy.pt $D/train300_clone_s$S.json train 50 runs/xp_b_s$S/policy.pt > runs/drift_b_s$S.log 2>&1 || exit 1
 done
 python $D/choose.py $D/train300_clone_s4.json $D/train300_clone_s5.json | tee $D/choice.txt
 C=$(python -c "import json; c=json.load(open('$D/choice.json'))['chosen']; print(c.split('_')[-1][:-5] if c else '')")
@@ -21,16 +21,14 @@ C=$(python -c "import json; c=json.load(open('$D/choice.json'))['chosen']; print
 P=runs/xp_b_$C/policy.pt
 cp $P $D/clone_${C}_policy.pt
 [ -f $D/clone_${C}_expert_cell.json ] || python docs/runs/xp_clone_drift/expert_cell.py $P $D/clone_${C}_expert_cell.json > runs/cell_b_$C.log 2>&1 || exit 1
-[ -f $D/test120_clone_$C.json ] || (cd $D && python ../student_xp_drift/drift.py ../../../$P test120_clone_$C.json --objects test --limit 20 --trials 3 --labeller ../../../$P) > runs/test120_b_$C.log 2>&1 || exit 1
+[ -f $D/test120_clone_$C.json ] || screen $P $D/test120_clone_$C.json test 20 $P > runs/test120_b_$C.log 2>&1 || exit 1
 E=runs/experts_b_$C
-for m in grasp relocate rotate_x+ rotate_x- rotate_y+ rotate_y- rotate_z+ rotate_z- translate_z+ translate_z-; do mkdir -p $E/$m; cp runs/experts1205x/$m/checkpoint.pt $E/$m/checkpoint.pt; done
-cp $P $E/rotate_x+/checkpoint.pt
+experts_with_xp $E $P
 BAR=$(python -c "import json; print(json.load(open('$D/clone_${C}_expert_cell.json'))['summary']['sr'] - 5)")
 for S in 0 1 2; do
   R=runs/l1b_w30_s$S
   if [ ! -f $D/student_cells_b_s$S.json ]; then
-    [ -f $R/checkpoint.pt ] && RES=--resume || RES=
-    unicross distill --experts $E --out $R --epochs 1500 $RES --set model.init_policy=runs/student_1204_morning.pt --set optim.lr=1.0e-4 --set optim.warmup_frames=102400 --set env.object_limit=null --set collector.rollout_steps=256 --set optim.grad_steps=30 --set optim.batch_size=1024 --set buffer.capacity=300000 --set logging.checkpoint_every=25 --set seed=$S --set env.chain_share=0.15 --set 'optim.mode_weights={rotate_x+: 30}' --set optim.l1=0.01 > $R.log 2>&1 || exit 1
+    stage $E $R $S || exit 1
     unicross export $R --out $D/student_l1_b_s$S.pt || exit 1
     python docs/runs/student_ft_1202b/seed_cells.py $D/student_l1_b_s$S.pt $D/student_cells_b_s$S.json > runs/cells_l1b_s$S.log 2>&1 || exit 1
   fi

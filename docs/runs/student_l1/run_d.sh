@@ -4,7 +4,7 @@
 set -x
 cd "$(dirname "$0")/../../.."
 source .venv/bin/activate
-D=docs/runs/student_l1
+source docs/runs/student_l1/common.sh
 while [ -f runs/student_l1_c.log ] && ! grep -q "^DONE" runs/student_l1_c.log; do sleep 20; done
 P=runs/xp_shipped_floor/policy.pt
 mkdir -p runs/xp_shipped_floor
@@ -18,7 +18,7 @@ ck["note"] = ("allegro/rotate_x+ (the shipped weights, unchanged) with model.obs
               "normaliser divides no feature by less than 1e-2 when it acts or labels (docs/runs/student_l1/rule.txt D1)")
 torch.save(ck, "runs/xp_shipped_floor/policy.pt")
 PY
-[ -f $D/train300_shipped_floor.json ] || (cd $D && python ../student_xp_drift/drift.py ../../../$P train300_shipped_floor.json --objects train --limit 50 --trials 3 --labeller ../../../$P) > runs/drift_shipped_floor.log 2>&1 || exit 1
+[ -f $D/train300_shipped_floor.json ] || screen $P $D/train300_shipped_floor.json train 50 $P > runs/drift_shipped_floor.log 2>&1 || exit 1
 python - <<'PY' || { echo "D1: does not qualify"; echo DONE; exit 0; }
 import json, sys
 s = json.load(open("docs/runs/student_l1/train300_shipped_floor.json"))["summary"]
@@ -29,14 +29,12 @@ sys.exit(0 if ok else 1)
 PY
 cp $P $D/shipped_floor_policy.pt
 [ -f $D/shipped_floor_expert_cell.json ] || python docs/runs/xp_clone_drift/expert_cell.py $P $D/shipped_floor_expert_cell.json > runs/cell_shipped_floor.log 2>&1 || exit 1
-[ -f $D/test120_shipped_floor.json ] || (cd $D && python ../student_xp_drift/drift.py ../../../$P test120_shipped_floor.json --objects test --limit 20 --trials 3 --labeller ../../../$P) > runs/test120_shipped_floor.log 2>&1 || exit 1
+[ -f $D/test120_shipped_floor.json ] || screen $P $D/test120_shipped_floor.json test 20 $P > runs/test120_shipped_floor.log 2>&1 || exit 1
 E=runs/experts_shipped_floor
-for m in grasp relocate rotate_x+ rotate_x- rotate_y+ rotate_y- rotate_z+ rotate_z- translate_z+ translate_z-; do mkdir -p $E/$m; cp runs/experts1205x/$m/checkpoint.pt $E/$m/checkpoint.pt; done
-cp $P $E/rotate_x+/checkpoint.pt
+experts_with_xp $E $P
 R=runs/l1fl_w30_s0
 if [ ! -f $D/student_cells_fl_s0.json ]; then
-  [ -f $R/checkpoint.pt ] && RES=--resume || RES=
-  unicross distill --experts $E --out $R --epochs 1500 $RES --set model.init_policy=runs/student_1204_morning.pt --set optim.lr=1.0e-4 --set optim.warmup_frames=102400 --set env.object_limit=null --set collector.rollout_steps=256 --set optim.grad_steps=30 --set optim.batch_size=1024 --set buffer.capacity=300000 --set logging.checkpoint_every=25 --set seed=0 --set env.chain_share=0.15 --set 'optim.mode_weights={rotate_x+: 30}' --set optim.l1=0.01 > $R.log 2>&1 || exit 1
+  stage $E $R 0 || exit 1
   unicross export $R --out $D/student_l1_fl_s0.pt || exit 1
   python docs/runs/student_ft_1202b/seed_cells.py $D/student_l1_fl_s0.pt $D/student_cells_fl_s0.json > runs/cells_l1fl_s0.log 2>&1 || exit 1
 fi

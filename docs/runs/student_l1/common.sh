@@ -1,0 +1,26 @@
+# Shared by run.sh, run_b.sh, run_c.sh and run_d.sh (sourced from the repository root, the venv active).
+D=docs/runs/student_l1
+
+# stage EXPERTS OUT SEED [--set ...]: the weight-30 stage with optim.l1 = 0.01 (rule.txt step 1), resumed when OUT has
+# a checkpoint; extra arguments are appended (screen C's env.mode_repeats)
+stage() {
+  local E=$1 R=$2 S=$3 RES=
+  shift 3
+  [ -f $R/checkpoint.pt ] && RES=--resume
+  unicross distill --experts $E --out $R --epochs 1500 $RES --set model.init_policy=runs/student_1204_morning.pt --set optim.lr=1.0e-4 --set optim.warmup_frames=102400 --set env.object_limit=null --set collector.rollout_steps=256 --set optim.grad_steps=30 --set optim.batch_size=1024 --set buffer.capacity=300000 --set logging.checkpoint_every=25 --set seed=$S --set env.chain_share=0.15 --set 'optim.mode_weights={rotate_x+: 30}' --set optim.l1=0.01 "$@" > $R.log 2>&1
+}
+
+# experts_with_xp DIR POLICY: the shipped experts (runs/experts1205x) with rotate_x+ replaced by POLICY
+experts_with_xp() {
+  local m
+  for m in grasp relocate rotate_x+ rotate_x- rotate_y+ rotate_y- rotate_z+ rotate_z- translate_z+ translate_z-; do
+    mkdir -p $1/$m; cp runs/experts1205x/$m/checkpoint.pt $1/$m/checkpoint.pt
+  done
+  cp $2 $1/rotate_x+/checkpoint.pt
+}
+
+# screen POLICY OUT.json OBJECTS LIMIT LABELLER: drift.py (docs/runs/student_xp_drift) on OBJECTS x 3 trials, paths
+# relative to the repository root
+screen() {
+  python docs/runs/student_xp_drift/drift.py $1 $2 --objects $3 --limit $4 --trials 3 --labeller $5
+}
