@@ -2,12 +2,12 @@
 D=docs/runs/student_l1
 
 # stage EXPERTS OUT SEED [--set ...]: the weight-30 stage with optim.l1 = 0.01 (rule.txt step 1), resumed when OUT has
-# a checkpoint; extra arguments are appended (screen C's env.mode_repeats)
+# a checkpoint; extra arguments are appended (screen C's env.mode_repeats); EPOCHS overrides the 1500 epochs (screen E)
 stage() {
   local E=$1 R=$2 S=$3 RES=
   shift 3
   [ -f $R/checkpoint.pt ] && RES=--resume
-  unicross distill --experts $E --out $R --epochs 1500 $RES --set model.init_policy=runs/student_1204_morning.pt --set optim.lr=1.0e-4 --set optim.warmup_frames=102400 --set env.object_limit=null --set collector.rollout_steps=256 --set optim.grad_steps=30 --set optim.batch_size=1024 --set buffer.capacity=300000 --set logging.checkpoint_every=25 --set seed=$S --set env.chain_share=0.15 --set 'optim.mode_weights={rotate_x+: 30}' --set optim.l1=0.01 "$@" > $R.log 2>&1
+  unicross distill --experts $E --out $R --epochs ${EPOCHS:-1500} $RES --set model.init_policy=runs/student_1204_morning.pt --set optim.lr=1.0e-4 --set optim.warmup_frames=102400 --set env.object_limit=null --set collector.rollout_steps=256 --set optim.grad_steps=30 --set optim.batch_size=1024 --set buffer.capacity=300000 --set logging.checkpoint_every=25 --set seed=$S --set env.chain_share=0.15 --set 'optim.mode_weights={rotate_x+: 30}' --set optim.l1=0.01 "$@" > $R.log 2>&1
 }
 
 # experts_with_xp DIR POLICY: the shipped experts (runs/experts1205x) with rotate_x+ replaced by POLICY
