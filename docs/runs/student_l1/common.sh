@@ -24,3 +24,23 @@ experts_with_xp() {
 screen() {
   python docs/runs/student_xp_drift/drift.py $1 $2 --objects $3 --limit $4 --trials 3 --labeller $5
 }
+
+# rep_screen RUN TAG SEED [stage arguments]: screens E and F (run_e.sh, run_f.sh): the stage into RUN with x+ walked
+# three times plus the arguments, its export $D/student_l1_rep3_TAG_sSEED.pt, drift.py on 300 training trials (seed 0
+# only), the report cells, then x+ on the 120 held-out trials; each step skipped when its file exists
+rep_screen() {
+  local R=$1 X=$2 S=$3 P N
+  shift 3
+  P=$D/student_l1_rep3_${X}_s$S.pt
+  N=$(basename $R)
+  if [ ! -f $D/student_cells_rep3_${X}_s$S.json ]; then
+    stage runs/experts1205x $R $S --set 'env.mode_repeats={rotate_x+: 3}' "$@" || return 1
+    unicross export $R --out $P || return 1
+    if [ "$S" = 0 ]; then
+      screen $P $D/train300_student_l1_rep3_${X}_s$S.json train 50 allegro/rotate_x+ > runs/drift_$N.log 2>&1 || return 1
+    fi
+    python docs/runs/student_ft_1202b/seed_cells.py $P $D/student_cells_rep3_${X}_s$S.json > runs/cells_$N.log 2>&1 || return 1
+  fi
+  [ -f $D/test120_student_l1_rep3_${X}_s$S.json ] \
+    || screen $P $D/test120_student_l1_rep3_${X}_s$S.json test 20 allegro/rotate_x+ > runs/drift_${N}_test.log 2>&1
+}
