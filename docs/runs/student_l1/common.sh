@@ -1,4 +1,4 @@
-# Shared by run.sh, run_b.sh, run_c.sh and run_d.sh (sourced from the repository root, the venv active).
+# Shared by the run scripts of this folder (sourced from the repository root, the venv active).
 D=docs/runs/student_l1
 
 # stage EXPERTS OUT SEED [--set ...]: the weight-30 stage with optim.l1 = 0.01 (rule.txt step 1), resumed when OUT has
@@ -25,22 +25,23 @@ screen() {
   python docs/runs/student_xp_drift/drift.py $1 $2 --objects $3 --limit $4 --trials 3 --labeller $5
 }
 
-# rep_screen RUN TAG SEED [stage arguments]: screens E and F (run_e.sh, run_f.sh): the stage into RUN with x+ walked
-# three times plus the arguments, its export $D/student_l1_rep3_TAG_sSEED.pt, drift.py on 300 training trials (seed 0
-# only), the report cells, then x+ on the 120 held-out trials; each step skipped when its file exists
+# rep_screen RUN TAG SEED [stage arguments]: screens C, E and F (run_c.sh, run_e.sh, run_f.sh): the stage into RUN
+# with x+ walked three times plus the arguments, its export $D/student_l1_rep3TAG_sSEED.pt (TAG "" for C, "_e1800",
+# "_w10"), drift.py on 300 training trials (seed 0 only), the report cells, then x+ on the 120 held-out trials; each
+# step skipped when its file exists
 rep_screen() {
   local R=$1 X=$2 S=$3 P N
   shift 3
-  P=$D/student_l1_rep3_${X}_s$S.pt
+  P=$D/student_l1_rep3${X}_s$S.pt
   N=$(basename $R)
-  if [ ! -f $D/student_cells_rep3_${X}_s$S.json ]; then
+  if [ ! -f $D/student_cells_rep3${X}_s$S.json ]; then
     stage runs/experts1205x $R $S --set 'env.mode_repeats={rotate_x+: 3}' "$@" || return 1
     unicross export $R --out $P || return 1
     if [ "$S" = 0 ]; then
-      screen $P $D/train300_student_l1_rep3_${X}_s$S.json train 50 allegro/rotate_x+ > runs/drift_$N.log 2>&1 || return 1
+      screen $P $D/train300_student_l1_rep3${X}_s$S.json train 50 allegro/rotate_x+ > runs/drift_$N.log 2>&1 || return 1
     fi
-    python docs/runs/student_ft_1202b/seed_cells.py $P $D/student_cells_rep3_${X}_s$S.json > runs/cells_$N.log 2>&1 || return 1
+    python docs/runs/student_ft_1202b/seed_cells.py $P $D/student_cells_rep3${X}_s$S.json > runs/cells_$N.log 2>&1 || return 1
   fi
-  [ -f $D/test120_student_l1_rep3_${X}_s$S.json ] \
-    || screen $P $D/test120_student_l1_rep3_${X}_s$S.json test 20 allegro/rotate_x+ > runs/drift_${N}_test.log 2>&1
+  [ -f $D/test120_student_l1_rep3${X}_s$S.json ] \
+    || screen $P $D/test120_student_l1_rep3${X}_s$S.json test 20 allegro/rotate_x+ > runs/drift_${N}_test.log 2>&1
 }

@@ -7,5 +7,5 @@ cd "$(dirname "$0")/../../.."
 source .venv/bin/activate
 source docs/runs/student_l1/common.sh
 S=${1:-0}
-EPOCHS=1800 rep_screen runs/l1rep3e1800_w30_s$S e1800 $S || exit 1
+EPOCHS=1800 rep_screen runs/l1rep3e1800_w30_s$S _e1800 $S || exit 1
 echo DONE

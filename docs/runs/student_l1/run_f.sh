@@ -7,5 +7,5 @@ cd "$(dirname "$0")/../../.."
 source .venv/bin/activate
 source docs/runs/student_l1/common.sh
 S=${1:-0}
-rep_screen runs/l1rep3w10_s$S w10 $S --set 'optim.mode_weights={rotate_x+: 10}' || exit 1
+rep_screen runs/l1rep3w10_s$S _w10 $S --set 'optim.mode_weights={rotate_x+: 10}' || exit 1
 echo DONE
