@@ -11,6 +11,7 @@ read from docs/runs/translate_zm_reference/thickness/student_cells_seed0.json (t
 """
 import json
 import os
+import re
 import sys
 
 from unicross.metrics import wilson_interval
@@ -48,7 +49,10 @@ if __name__ == "__main__":
         args = args[2:]
     pool, cells = pooled(args)
     ok = True
-    print("| cell | " + " | ".join(f"seed {i}" for i in range(len(cells))) + " | pooled [95% CI] | bar | |")
+    # a column per file, named by the seed in its name (``..._s3.json``, ``..._seed3.json``), else by its position
+    names = [(lambda m: f"seed {m.group(1)}" if m else f"file {i + 1}")(re.search(r"_s(?:eed)?(\d+)\.json$", f))
+             for i, f in enumerate(args)]
+    print("| cell | " + " | ".join(names) + " | pooled [95% CI] | bar | |")
     print("|---|" + "---|" * len(cells) + "---|---|---|")
     for name, (k, n) in pool.items():
         sr = 100 * k / n
