@@ -1,20 +1,23 @@
 # Shared by the run scripts of this folder (sourced from the repository root, the venv active).
 D=docs/runs/student_l1
+MODES="grasp relocate rotate_x+ rotate_x- rotate_y+ rotate_y- rotate_z+ rotate_z- translate_z+ translate_z-"
 
 # stage EXPERTS OUT SEED [--set ...]: the weight-30 stage with optim.l1 = 0.01 (rule.txt step 1), resumed when OUT has
 # a checkpoint; extra arguments are appended (screen C's env.mode_repeats); EPOCHS overrides the 1500 epochs (screen E)
 stage() {
   local E=$1 R=$2 S=$3 RES=
   shift 3
+  experts_dir || return 1
   [ -f $R/checkpoint.pt ] && RES=--resume
   unicross distill --experts $E --out $R --epochs ${EPOCHS:-1500} $RES --set model.init_policy=runs/student_1204_morning.pt --set optim.lr=1.0e-4 --set optim.warmup_frames=102400 --set env.object_limit=null --set collector.rollout_steps=256 --set optim.grad_steps=30 --set optim.batch_size=1024 --set buffer.capacity=300000 --set logging.checkpoint_every=25 --set seed=$S --set env.chain_share=0.15 --set 'optim.mode_weights={rotate_x+: 30}' --set optim.l1=0.01 "$@" > $R.log 2>&1
 }
 
 # experts_dir: runs/experts1205x (the ten shipped experts, unicross/checkpoints/allegro/<mode>.pt, as
-# <mode>/checkpoint.pt) and runs/student_1204_morning.pt (the stage's default init), made when missing (a fresh checkout)
+# <mode>/checkpoint.pt) and runs/student_1204_morning.pt (the stage's default init), made when missing (a fresh
+# checkout); stage and experts_with_xp call it
 experts_dir() {
   local m
-  for m in grasp relocate rotate_x+ rotate_x- rotate_y+ rotate_y- rotate_z+ rotate_z- translate_z+ translate_z-; do
+  for m in $MODES; do
     [ -f runs/experts1205x/$m/checkpoint.pt ] && continue
     mkdir -p runs/experts1205x/$m && cp unicross/checkpoints/allegro/$m.pt runs/experts1205x/$m/checkpoint.pt || return 1
   done
@@ -24,7 +27,8 @@ experts_dir() {
 # experts_with_xp DIR POLICY: the shipped experts (runs/experts1205x) with rotate_x+ replaced by POLICY
 experts_with_xp() {
   local m
-  for m in grasp relocate rotate_x+ rotate_x- rotate_y+ rotate_y- rotate_z+ rotate_z- translate_z+ translate_z-; do
+  experts_dir || return 1
+  for m in $MODES; do
     mkdir -p $1/$m; cp runs/experts1205x/$m/checkpoint.pt $1/$m/checkpoint.pt
   done
   cp $2 $1/rotate_x+/checkpoint.pt
@@ -36,9 +40,9 @@ screen() {
   python docs/runs/student_xp_drift/drift.py $1 $2 --objects $3 --limit $4 --trials 3 --labeller $5
 }
 
-# rep_screen RUN TAG SEED [stage arguments]: screens C, E and F (run_c.sh, run_e.sh, run_f.sh): the stage into RUN
-# with x+ walked three times plus the arguments, its export $D/student_l1_rep3TAG_sSEED.pt (TAG "" for C, "_e1800",
-# "_w10"), drift.py on 300 training trials (seed 0 only), the report cells, then x+ on the 120 held-out trials; each
+# rep_screen RUN TAG SEED [stage arguments]: screens C, E, F and G (run_c.sh, run_e.sh, run_f.sh, run_g.sh): the stage
+# into RUN with x+ walked three times plus the arguments, its export $D/student_l1_rep3TAG_sSEED.pt (TAG "" for C,
+# "_e1800", "_w10", "_w10ship"), drift.py on 300 training trials (seed 0 only), the report cells, then x+ on the 120 held-out trials; each
 # step skipped when its file exists
 rep_screen() {
   local R=$1 X=$2 S=$3 P N

@@ -8,7 +8,6 @@ cd "$(dirname "$0")/../../.."
 source .venv/bin/activate
 source docs/runs/student_l1/common.sh
 S=${1:-1}
-experts_dir || exit 1
 rep_screen runs/l1rep3w10ship_s$S _w10ship $S --set 'optim.mode_weights={rotate_x+: 10}' \
     --set model.init_policy=allegro/student || exit 1
 echo DONE

@@ -50,8 +50,8 @@ if __name__ == "__main__":
     pool, cells = pooled(args)
     ok = True
     # a column per file, named by the seed in its name (``..._s3.json``, ``..._seed3.json``), else by its position
-    names = [(lambda m: f"seed {m.group(1)}" if m else f"file {i + 1}")(re.search(r"_s(?:eed)?(\d+)\.json$", f))
-             for i, f in enumerate(args)]
+    seeds = [re.search(r"_s(?:eed)?(\d+)\.json$", f) for f in args]
+    names = [f"seed {m.group(1)}" if m else f"file {i + 1}" for i, m in enumerate(seeds)]
     print("| cell | " + " | ".join(names) + " | pooled [95% CI] | bar | |")
     print("|---|" + "---|" * len(cells) + "---|---|---|")
     for name, (k, n) in pool.items():
