@@ -1,0 +1,103 @@
+"""Ship seed 1 of a judged screen of this folder (rule.txt G2 / H2) as allegro/student: copy its committed export,
+then rewrite the sidecar (the replaced record under ``replaced``; seeds 2 and 3 under ``other_seeds``).
+
+    python docs/runs/student_l1/ship.py SCREEN [--dry]
+
+SCREEN is a letter of ``SCREENS`` (G: x+ weight 10, H: x+ weight 15; both x+ walked three times, l1 0.01, from the
+shipped student). It refuses to write unless the screen's judge3.py output (``judge_<screen>.txt``, e.g. judge_h.txt)
+ends in PASSED; ``--dry`` prints the new sidecar without writing anything. The stage command in the sidecar is common.sh's ``stage`` with the screen's
+arguments, as run_g.sh / run_h.sh call it.
+"""
+import json
+import shutil
+import sys
+
+import torch
+
+D = "docs/runs/student_l1"
+CK = "unicross/checkpoints/allegro/student"
+SCREENS = {"G": dict(tag="_w10ship", weight=10), "H": dict(tag="_w15ship", weight=15)}
+MODES = "grasp relocate rotate_x+ rotate_x- rotate_y+ rotate_y- rotate_z+ rotate_z- translate_z+ translate_z-"
+
+if __name__ == "__main__":
+    args = [a for a in sys.argv[1:] if a != "--dry"]
+    dry = "--dry" in sys.argv
+    if len(args) != 1 or args[0] not in SCREENS:
+        sys.exit(f"usage: python {D}/ship.py SCREEN [--dry], SCREEN one of {', '.join(SCREENS)}")
+    name = args[0]
+    tag, weight = SCREENS[name]["tag"], SCREENS[name]["weight"]
+    run = f"runs/l1rep3{tag.strip('_')}_s{{s}}"
+    export = f"{D}/student_l1_rep3{tag}_s{{s}}"
+    cells_of = f"{D}/student_cells_rep3{tag}_s{{s}}.json"
+
+    judge = f"{D}/judge_{name.lower()}.txt"
+    try:
+        verdict = open(judge).read().split()[-1]
+    except FileNotFoundError:
+        verdict = "missing"
+    if verdict != "PASSED" and not dry:
+        sys.exit(f"{judge}: {verdict}; screen {name} does not ship (rule.txt {name}2)")
+    old = json.load(open(f"{CK}.json"))
+    if old.get("rule", "").startswith(D):  # run again after shipping: keep the record it replaced
+        old = old["replaced"]
+    ck = torch.load(f"{export.format(s=1)}.pt", map_location="cpu", weights_only=False)
+    wall_s = json.load(open(f"{export.format(s=1)}.json"))["train_wall_s"]  # the stage's, from the export's sidecar
+    stage = ("unicross distill --experts runs/experts1205x --out " + run + " --epochs 1500 "
+             "--set model.init_policy=runs/student_1204_morning.pt --set optim.lr=1.0e-4 "
+             "--set optim.warmup_frames=102400 --set env.object_limit=null --set collector.rollout_steps=256 "
+             "--set optim.grad_steps=30 --set optim.batch_size=1024 --set buffer.capacity=300000 "
+             "--set logging.checkpoint_every=25 --set seed={s} --set env.chain_share=0.15 "
+             "--set 'optim.mode_weights={{rotate_x+: 30}}' --set optim.l1=0.01 "
+             "--set 'env.mode_repeats={{rotate_x+: 3}}' "
+             f"--set 'optim.mode_weights={{{{rotate_x+: {weight}}}}}' --set model.init_policy=allegro/student")
+    commands = old["commands"] + [
+        f"mkdir -p runs/experts1205x; for m in {MODES}; do mkdir -p runs/experts1205x/$m; "
+        "cp unicross/checkpoints/allegro/$m.pt runs/experts1205x/$m/checkpoint.pt; done   # the ten shipped experts "
+        f"of commit fe6c582 (rotate x+ = the clone of the x+ finger sequence); {D}/common.sh: experts_dir",
+        stage.format(s=1) + f"   # commit {ck['git_commit'][:7]}, {wall_s / 60:.0f} min on 2 cores ({D}/rule.txt "
+        f"screen {name}; later --set values override earlier ones: init = the student this replaces, "
+        f"x+ weight {weight})",
+        f"unicross export {run.format(s=1)} --out {export.format(s=1)}.pt",
+        f"python docs/runs/student_ft_1202b/seed_cells.py {export.format(s=1)}.pt {cells_of.format(s=1)}   "
+        "# the report's test cells and long horizon, 7 min",
+        "python docs/runs/student_xp_drift/judge3.py " + " ".join(cells_of.format(s=s) for s in (1, 2, 3))
+        + f"   # rule.txt {name}2",
+        f"cp {export.format(s=1)}.pt {CK}.pt   # python {D}/ship.py {name} (this sidecar)",
+    ]
+
+    def test_cells(c):
+        return {m: v["cell"] for m, v in c["test"].items()}
+
+    def overall(c):
+        return {k: v["overall"]["sr"] for k, v in c["long_horizon"]["summary"].items()}
+
+    cells = json.load(open(cells_of.format(s=1)))
+    seeds = []
+    for s in (2, 3):
+        c = json.load(open(cells_of.format(s=s)))
+        seeds.append(dict(seed=s, command=stage.format(s=s) + f" (export {export.format(s=s)}.pt); judged pooled "
+                          "with seed 1, not chosen on", test_cells=test_cells(c), long_horizon_overall=overall(c)))
+    new = dict(
+        skill=ck["skill"], axis=ck["axis"], hand=ck["hand"], epoch=ck["epoch"], frames=old["frames"] + ck["frames"],
+        distilled_modes=ck["distilled_modes"], git_commit=ck["git_commit"],
+        commits=old["commits"] + [ck["git_commit"]], commands=commands, hardware=old["hardware"],
+        train_wall_s=round(old["train_wall_s"] + wall_s, 1), stage_frames=ck["frames"], stage_wall_s=round(wall_s, 1),
+        frames_note="frames and train_wall_s count every stage from the first DAgger run: the student this replaces "
+                    f"({old['frames']} frames, {old['train_wall_s']} s; its own frames_note under replaced) and this "
+                    f"stage (stage_frames, stage_wall_s: rotate x+ walked three times with weight {weight}, l1 0.01, "
+                    "env.chain_share 0.15, on the ten shipped experts)",
+        rule=f"{D}/rule.txt screen {name} (three seeds pooled, docs/runs/student_xp_drift/judge3.py; seed 1 named "
+             "before the runs)",
+        teachers="the ten Allegro experts shipped at commit fe6c582 (rotate x+ = the clone of the x+ finger sequence)",
+        test_cells=test_cells(cells), long_horizon_overall=overall(cells), other_seeds=seeds,
+        long_horizon_note="the stage acts in long-horizon chains too (env.chain_share 0.15); per seed and pooled in "
+                          f"{D}/README.md",
+        replaced=old,
+    )
+    if dry:
+        print(json.dumps({k: v for k, v in new.items() if k not in ("replaced", "commands")}, indent=1))
+        print("\n".join(["commands (the last six):"] + commands[-6:]))
+    else:
+        shutil.copyfile(f"{export.format(s=1)}.pt", f"{CK}.pt")
+        json.dump(new, open(f"{CK}.json", "w"), indent=1)
+        print(f"wrote {CK}.pt and {CK}.json")
