@@ -40,10 +40,10 @@ screen() {
   python docs/runs/student_xp_drift/drift.py $1 $2 --objects $3 --limit $4 --trials 3 --labeller $5
 }
 
-# rep_screen RUN TAG SEED [stage arguments]: screens C, E, F and G (run_c.sh, run_e.sh, run_f.sh, run_g.sh): the stage
-# into RUN with x+ walked three times plus the arguments, its export $D/student_l1_rep3TAG_sSEED.pt (TAG "" for C,
-# "_e1800", "_w10", "_w10ship"), drift.py on 300 training trials (seed 0 only), the report cells, then x+ on the 120 held-out trials; each
-# step skipped when its file exists
+# rep_screen RUN TAG SEED [stage arguments]: screens C, E, F, G and H (run_c.sh ... run_h.sh): the stage into RUN
+# with x+ walked three times plus the arguments, its export $D/student_l1_rep3TAG_sSEED.pt (TAG "" for C, "_e1800",
+# "_w10", "_w10ship", "_w15ship"), drift.py on 300 training trials (seed 0 only), the report cells, then x+ on the 120
+# held-out trials; each step skipped when its file exists
 rep_screen() {
   local R=$1 X=$2 S=$3 P N
   shift 3
@@ -59,4 +59,11 @@ rep_screen() {
   fi
   [ -f $D/test120_student_l1_rep3${X}_s$S.json ] \
     || screen $P $D/test120_student_l1_rep3${X}_s$S.json test 20 allegro/rotate_x+ > runs/drift_${N}_test.log 2>&1
+}
+
+# ship_screen WEIGHT SEED: screens G (weight 10) and H (weight 15): rep_screen from the shipped student with x+ weight
+# WEIGHT, into runs/l1rep3wWEIGHTship_sSEED, tag _wWEIGHTship (ship.py derives the same names from the weight)
+ship_screen() {
+  rep_screen runs/l1rep3w$1ship_s$2 _w$1ship $2 --set "optim.mode_weights={rotate_x+: $1}" \
+    --set model.init_policy=allegro/student
 }

@@ -5,8 +5,8 @@ then rewrite the sidecar (the replaced record under ``replaced``; seeds 2 and 3 
 
 SCREEN is a letter of ``SCREENS`` (G: x+ weight 10, H: x+ weight 15; both x+ walked three times, l1 0.01, from the
 shipped student). It refuses to write unless the screen's judge3.py output (``judge_<screen>.txt``, e.g. judge_h.txt)
-ends in PASSED; ``--dry`` prints the new sidecar without writing anything. The stage command in the sidecar is common.sh's ``stage`` with the screen's
-arguments, as run_g.sh / run_h.sh call it.
+ends in PASSED; ``--dry`` prints the new sidecar without writing anything. The stage command in the sidecar is
+common.sh's ``stage`` with ``ship_screen``'s arguments, as run_g.sh / run_h.sh call it.
 """
 import json
 import shutil
@@ -16,7 +16,7 @@ import torch
 
 D = "docs/runs/student_l1"
 CK = "unicross/checkpoints/allegro/student"
-SCREENS = {"G": dict(tag="_w10ship", weight=10), "H": dict(tag="_w15ship", weight=15)}
+SCREENS = {"G": 10, "H": 15}  # the x+ weight; the run, export and cells names follow it (common.sh: ship_screen)
 MODES = "grasp relocate rotate_x+ rotate_x- rotate_y+ rotate_y- rotate_z+ rotate_z- translate_z+ translate_z-"
 
 if __name__ == "__main__":
@@ -25,7 +25,8 @@ if __name__ == "__main__":
     if len(args) != 1 or args[0] not in SCREENS:
         sys.exit(f"usage: python {D}/ship.py SCREEN [--dry], SCREEN one of {', '.join(SCREENS)}")
     name = args[0]
-    tag, weight = SCREENS[name]["tag"], SCREENS[name]["weight"]
+    weight = SCREENS[name]
+    tag = f"_w{weight}ship"
     run = f"runs/l1rep3{tag.strip('_')}_s{{s}}"
     export = f"{D}/student_l1_rep3{tag}_s{{s}}"
     cells_of = f"{D}/student_cells_rep3{tag}_s{{s}}.json"
