@@ -8,18 +8,11 @@ students. It measures how far the expert's seed-0 cell (24, the bar's base) stan
 import json
 import sys
 
-from unicross.report import PaperReport
+from rotate_seeds import seed_cells
 
 D = "docs/runs/student_l1"
 POLICIES = ["allegro/rotate_x+"] + [f"{D}/student_l1_rep3_w10ship_s{s}.pt" for s in (1, 2, 3)]
 
 if __name__ == "__main__":
-    out = {}
-    for spec in POLICIES:
-        for seed in (1, 2, 3):
-            rep = PaperReport(hand="allegro", limit=10, trials=3, workers=2, seed=seed, min_trials=100)
-            cell = rep.evaluate("rotate_x+", spec, "test")
-            s = rep.summaries[("rotate_x+", spec, "test", False)]
-            out.setdefault(spec, {})[seed] = dict(cell=cell, successes=s["successes"], n=s["n"])
-            print(spec, seed, cell, flush=True)
+    out = {spec: seed_cells(spec, ["rotate_x+"], (1, 2, 3))["rotate_x+"] for spec in POLICIES}
     json.dump(out, open(sys.argv[1], "w"), indent=1, default=float)

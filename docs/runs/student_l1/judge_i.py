@@ -1,0 +1,75 @@
+"""rule.txt screen I, step I3: the three seeds' students against their experts, rotate cells over four evaluation
+seeds.
+
+    python docs/runs/student_l1/judge_i.py > docs/runs/student_l1/judge_i.txt
+
+Rotate cells: the student's successes pooled over training seeds 4, 5, 6 and evaluation seeds 0-3 (n = 1200; seed 0
+from student_cells_rep3_w10ship_sS.json, 1-3 from rotate_seeds_rep3_w10ship_sS.json) against the mode's shipped
+expert over evaluation seeds 0-3 (rotate_seeds_experts.json, n = 400) minus 5 points. Every other cell as judge3.py:
+the evaluation-seed-0 cells pooled over the three students against docs/results.md's expert cell - 5 (grasp,
+relocate, translate) and the shipped student's long horizon - 5. The last line is PASSED or FAILED (ship.py reads it).
+"""
+import importlib.util
+import json
+import os
+import sys
+
+from unicross.metrics import wilson_interval
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+SEEDS = (4, 5, 6)
+EVAL_SEEDS = ("0", "1", "2", "3")
+spec = importlib.util.spec_from_file_location("judge3", os.path.join(HERE, "..", "student_xp_drift", "judge3.py"))
+judge3 = importlib.util.module_from_spec(spec)
+spec.loader.exec_module(judge3)
+
+
+def ci(k, n):
+    lo, hi = (100 * x for x in wilson_interval(k, n))
+    return f"{100 * k / n:.1f} [{lo:.1f}-{hi:.1f}] (n={n})"
+
+
+if __name__ == "__main__":
+    cells_files = [os.path.join(HERE, f"student_cells_rep3_w10ship_s{s}.json") for s in SEEDS]
+    rot_files = [os.path.join(HERE, f"rotate_seeds_rep3_w10ship_s{s}.json") for s in SEEDS]
+    missing = [f for f in cells_files + rot_files if not os.path.exists(f)]
+    if missing:
+        sys.exit("missing: " + ", ".join(missing))
+    experts = json.load(open(os.path.join(HERE, "rotate_seeds_experts.json")))["cells"]
+    pool, cells = judge3.pooled(cells_files)
+    rots = [json.load(open(f))["cells"] for f in rot_files]
+    shipped = json.load(open(os.path.join(HERE, "..", "translate_zm_reference", "thickness",
+                                          "student_cells_seed0.json")))
+    ok = True
+    print("| cell | seed 4 | seed 5 | seed 6 | student pooled [95% CI] | expert [95% CI] | bar | |")
+    print("|---|---|---|---|---|---|---|---|")
+    for name, (k, n) in pool.items():
+        if name.startswith("rotate_"):
+            ex = experts[name]
+            if ex["0"]["cell"] != judge3.EXPERT[name]:
+                print(f"note: {name}: the expert's seed-0 cell measured {ex['0']['cell']:g}, "
+                      f"docs/results.md {judge3.EXPERT[name]:g}")
+            ke, ne = (sum(ex[e][f] for e in EVAL_SEEDS) for f in ("successes", "n"))
+            per_k = [c["test"][name]["summary"]["successes"] + sum(r[name][e]["successes"] for e in EVAL_SEEDS[1:])
+                     for c, r in zip(cells, rots)]
+            per_n = [c["test"][name]["summary"]["n"] + sum(r[name][e]["n"] for e in EVAL_SEEDS[1:])
+                     for c, r in zip(cells, rots)]
+            k, n = sum(per_k), sum(per_n)
+            per = [100 * a / b for a, b in zip(per_k, per_n)]
+            expert = ci(ke, ne)
+            bar = 100 * ke / ne - 5
+        elif name in judge3.EXPERT:
+            per = [c["test"][name]["summary"]["sr"] for c in cells]
+            expert = f"{judge3.EXPERT[name]:g} (n=100+, seed 0)"
+            bar = judge3.EXPERT[name] - 5
+        else:
+            per = [c["long_horizon"]["summary"][name]["overall"]["sr"] for c in cells]
+            ref = shipped["long_horizon"]["summary"][name]["overall"]["sr"]
+            expert = f"shipped student {ref:g}"
+            bar = ref - 5
+        good = 100 * k / n >= bar - 1e-9
+        ok &= good
+        print(f"| {name} | " + " | ".join(f"{p:.1f}" for p in per) + f" | {ci(k, n)} | {expert} | >= {bar:.2f} | "
+              f"{'ok' if good else 'MISSED'} |")
+    print(f"rule.txt I3: {'PASSED' if ok else 'FAILED'}")
+    sys.exit(0 if ok else 1)
