@@ -1,11 +1,12 @@
-"""Ship seed 1 of a judged screen of this folder (rule.txt G2 / H2) as allegro/student: copy its committed export,
-then rewrite the sidecar (the replaced record under ``replaced``; seeds 2 and 3 under ``other_seeds``).
+"""Ship the named seed of a judged screen of this folder (rule.txt G2 / H2 / I3) as allegro/student: copy its
+committed export, then rewrite the sidecar (the replaced record under ``replaced``; the other two seeds under
+``other_seeds``).
 
     python docs/runs/student_l1/ship.py SCREEN [--dry]
 
-SCREEN is a letter of ``SCREENS`` (G: x+ weight 10, H: x+ weight 15; both x+ walked three times, l1 0.01, from the
-shipped student). It refuses to write unless the screen's judge3.py output (``judge_<screen>.txt``, e.g. judge_h.txt)
-ends in PASSED; ``--dry`` prints the new sidecar without writing anything. The stage command in the sidecar is
+SCREEN is a key of ``SCREENS`` (G: x+ weight 10, seeds 1-3; H: x+ weight 15, seeds 1-3; I: G's recipe on seeds 4-6,
+rotate cells over evaluation seeds 0-3; all x+ walked three times, l1 0.01, from the shipped student). It refuses to
+write unless the screen's judge output (``judge_<screen>.txt``, e.g. judge_h.txt) ends in PASSED; ``--dry`` prints the new sidecar without writing anything. The stage command in the sidecar is
 common.sh's ``stage`` with ``ship_screen``'s arguments, as run_g.sh / run_h.sh call it.
 """
 import json
@@ -16,7 +17,11 @@ import torch
 
 D = "docs/runs/student_l1"
 CK = "unicross/checkpoints/allegro/student"
-SCREENS = {"G": 10, "H": 15}  # the x+ weight; the run, export and cells names follow it (common.sh: ship_screen)
+# the x+ weight (the run, export and cells names follow it: common.sh ship_screen), the seeds (the first ships) and
+# the judge's command
+JUDGE3 = "python docs/runs/student_xp_drift/judge3.py {cells}"
+SCREENS = {"G": (10, (1, 2, 3), JUDGE3), "H": (15, (1, 2, 3), JUDGE3),
+           "I": (10, (4, 5, 6), f"python {D}/judge_i.py   # also reads {D}/rotate_seeds_*.json")}
 MODES = "grasp relocate rotate_x+ rotate_x- rotate_y+ rotate_y- rotate_z+ rotate_z- translate_z+ translate_z-"
 
 if __name__ == "__main__":
@@ -25,7 +30,7 @@ if __name__ == "__main__":
     if len(args) != 1 or args[0] not in SCREENS:
         sys.exit(f"usage: python {D}/ship.py SCREEN [--dry], SCREEN one of {', '.join(SCREENS)}")
     name = args[0]
-    weight = SCREENS[name]
+    weight, (ship_seed, *others), judge_cmd = SCREENS[name]
     tag = f"_w{weight}ship"
     run = f"runs/l1rep3{tag.strip('_')}_s{{s}}"
     export = f"{D}/student_l1_rep3{tag}_s{{s}}"
@@ -37,12 +42,12 @@ if __name__ == "__main__":
     except FileNotFoundError:
         verdict = "missing"
     if verdict != "PASSED" and not dry:
-        sys.exit(f"{judge}: {verdict}; screen {name} does not ship (rule.txt {name}2)")
+        sys.exit(f"{judge}: {verdict}; screen {name} does not ship (rule.txt screen {name})")
     old = json.load(open(f"{CK}.json"))
     if old.get("rule", "").startswith(D):  # run again after shipping: keep the record it replaced
         old = old["replaced"]
-    ck = torch.load(f"{export.format(s=1)}.pt", map_location="cpu", weights_only=False)
-    wall_s = json.load(open(f"{export.format(s=1)}.json"))["train_wall_s"]  # the stage's, from the export's sidecar
+    ck = torch.load(f"{export.format(s=ship_seed)}.pt", map_location="cpu", weights_only=False)
+    wall_s = json.load(open(f"{export.format(s=ship_seed)}.json"))["train_wall_s"]  # the stage's, from the export's sidecar
     stage = ("unicross distill --experts runs/experts1205x --out " + run + " --epochs 1500 "
              "--set model.init_policy=runs/student_1204_morning.pt --set optim.lr=1.0e-4 "
              "--set optim.warmup_frames=102400 --set env.object_limit=null --set collector.rollout_steps=256 "
@@ -55,15 +60,15 @@ if __name__ == "__main__":
         f"mkdir -p runs/experts1205x; for m in {MODES}; do mkdir -p runs/experts1205x/$m; "
         "cp unicross/checkpoints/allegro/$m.pt runs/experts1205x/$m/checkpoint.pt; done   # the ten shipped experts "
         f"of commit fe6c582 (rotate x+ = the clone of the x+ finger sequence); {D}/common.sh: experts_dir",
-        stage.format(s=1) + f"   # commit {ck['git_commit'][:7]}, {wall_s / 60:.0f} min on 2 cores ({D}/rule.txt "
+        stage.format(s=ship_seed) + f"   # commit {ck['git_commit'][:7]}, {wall_s / 60:.0f} min on 2 cores ({D}/rule.txt "
         f"screen {name}; later --set values override earlier ones: init = the student this replaces, "
         f"x+ weight {weight})",
-        f"unicross export {run.format(s=1)} --out {export.format(s=1)}.pt",
-        f"python docs/runs/student_ft_1202b/seed_cells.py {export.format(s=1)}.pt {cells_of.format(s=1)}   "
-        "# the report's test cells and long horizon, 7 min",
-        "python docs/runs/student_xp_drift/judge3.py " + " ".join(cells_of.format(s=s) for s in (1, 2, 3))
-        + f"   # rule.txt {name}2",
-        f"cp {export.format(s=1)}.pt {CK}.pt   # python {D}/ship.py {name} (this sidecar)",
+        f"unicross export {run.format(s=ship_seed)} --out {export.format(s=ship_seed)}.pt",
+        f"python docs/runs/student_ft_1202b/seed_cells.py {export.format(s=ship_seed)}.pt "
+        f"{cells_of.format(s=ship_seed)}   # the report's test cells and long horizon, 7 min",
+        judge_cmd.format(cells=" ".join(cells_of.format(s=s) for s in (ship_seed, *others)))
+        + f"   # rule.txt screen {name}",
+        f"cp {export.format(s=ship_seed)}.pt {CK}.pt   # python {D}/ship.py {name} (this sidecar)",
     ]
 
     def test_cells(c):
@@ -72,12 +77,12 @@ if __name__ == "__main__":
     def overall(c):
         return {k: v["overall"]["sr"] for k, v in c["long_horizon"]["summary"].items()}
 
-    cells = json.load(open(cells_of.format(s=1)))
+    cells = json.load(open(cells_of.format(s=ship_seed)))
     seeds = []
-    for s in (2, 3):
+    for s in others:
         c = json.load(open(cells_of.format(s=s)))
         seeds.append(dict(seed=s, command=stage.format(s=s) + f" (export {export.format(s=s)}.pt); judged pooled "
-                          "with seed 1, not chosen on", test_cells=test_cells(c), long_horizon_overall=overall(c)))
+                          f"with seed {ship_seed}, not chosen on", test_cells=test_cells(c), long_horizon_overall=overall(c)))
     new = dict(
         skill=ck["skill"], axis=ck["axis"], hand=ck["hand"], epoch=ck["epoch"], frames=old["frames"] + ck["frames"],
         distilled_modes=ck["distilled_modes"], git_commit=ck["git_commit"],
@@ -87,7 +92,7 @@ if __name__ == "__main__":
                     f"({old['frames']} frames, {old['train_wall_s']} s; its own frames_note under replaced) and this "
                     f"stage (stage_frames, stage_wall_s: rotate x+ walked three times with weight {weight}, l1 0.01, "
                     "env.chain_share 0.15, on the ten shipped experts)",
-        rule=f"{D}/rule.txt screen {name} (three seeds pooled, docs/runs/student_xp_drift/judge3.py; seed 1 named "
+        rule=f"{D}/rule.txt screen {name} (three seeds pooled, {judge_cmd.split()[1]}; seed {ship_seed} named "
              "before the runs)",
         teachers="the ten Allegro experts shipped at commit fe6c582 (rotate x+ = the clone of the x+ finger sequence)",
         test_cells=test_cells(cells), long_horizon_overall=overall(cells), other_seeds=seeds,
@@ -99,6 +104,6 @@ if __name__ == "__main__":
         print(json.dumps({k: v for k, v in new.items() if k not in ("replaced", "commands")}, indent=1))
         print("\n".join(["commands (the last six):"] + commands[-6:]))
     else:
-        shutil.copyfile(f"{export.format(s=1)}.pt", f"{CK}.pt")
+        shutil.copyfile(f"{export.format(s=ship_seed)}.pt", f"{CK}.pt")
         json.dump(new, open(f"{CK}.json", "w"), indent=1)
         print(f"wrote {CK}.pt and {CK}.json")
