@@ -46,8 +46,9 @@ if __name__ == "__main__":
     for name, (k, n) in pool.items():
         if name.startswith("rotate_"):
             ex = experts[name]
-            if ex["0"]["cell"] != judge3.EXPERT[name]:
-                print(f"note: {name}: the expert's seed-0 cell measured {ex['0']['cell']:g}, "
+            measured = 100 * ex["0"]["successes"] / ex["0"]["n"]
+            if measured != judge3.EXPERT[name]:
+                print(f"note: {name}: the expert's seed-0 cell measured {measured:g}, "
                       f"docs/results.md {judge3.EXPERT[name]:g}")
             ke, ne = (sum(ex[e][f] for e in EVAL_SEEDS) for f in ("successes", "n"))
             per_k = [c["test"][name]["summary"]["successes"] + sum(r[name][e]["successes"] for e in EVAL_SEEDS[1:])
