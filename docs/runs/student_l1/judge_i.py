@@ -51,10 +51,9 @@ if __name__ == "__main__":
                 print(f"note: {name}: the expert's seed-0 cell measured {measured:g}, "
                       f"docs/results.md {judge3.EXPERT[name]:g}")
             ke, ne = (sum(ex[e][f] for e in EVAL_SEEDS) for f in ("successes", "n"))
-            per_k = [c["test"][name]["summary"]["successes"] + sum(r[name][e]["successes"] for e in EVAL_SEEDS[1:])
-                     for c, r in zip(cells, rots)]
-            per_n = [c["test"][name]["summary"]["n"] + sum(r[name][e]["n"] for e in EVAL_SEEDS[1:])
-                     for c, r in zip(cells, rots)]
+            # per student: (successes, n) of evaluation seed 0 (the report's cell) and seeds 1-3
+            per_k, per_n = zip(*[[c["test"][name]["summary"][f] + sum(r[name][e][f] for e in EVAL_SEEDS[1:])
+                                  for f in ("successes", "n")] for c, r in zip(cells, rots)])
             k, n = sum(per_k), sum(per_n)
             per = [100 * a / b for a, b in zip(per_k, per_n)]
             expert = ci(ke, ne)
