@@ -1,10 +1,11 @@
-"""rule.txt screen I, step I3: the three seeds' students against their experts, rotate cells over four evaluation
-seeds.
+"""rule.txt screens I (step I3) and J (J3): the three seeds' students against their experts, rotate cells over four
+evaluation seeds.
 
-    python docs/runs/student_l1/judge_i.py > docs/runs/student_l1/judge_i.txt
+    python docs/runs/student_l1/judge_i.py [SCREEN] > docs/runs/student_l1/judge_<screen>.txt
 
-Rotate cells: the student's successes pooled over training seeds 4, 5, 6 and evaluation seeds 0-3 (n = 1200; seed 0
-from student_cells_rep3_w10ship_sS.json, 1-3 from rotate_seeds_rep3_w10ship_sS.json) against the mode's shipped
+SCREEN (default I) names the students: I, x+ weight 10 on training seeds 4, 5, 6 (tag _w10ship); J, x+ weight 5 on
+seeds 7, 8, 9 (tag _w5ship). Rotate cells: the student's successes pooled over its three training seeds and evaluation
+seeds 0-3 (n = 1200; seed 0 from student_cells_rep3TAG_sS.json, 1-3 from rotate_seeds_rep3TAG_sS.json) against the mode's shipped
 expert over evaluation seeds 0-3 (rotate_seeds_experts.json, n = 400) minus 5 points. Every other cell as judge3.py:
 the evaluation-seed-0 cells pooled over the three students against docs/results.md's expert cell - 5 (grasp,
 relocate, translate) and the shipped student's long horizon - 5. The last line is PASSED or FAILED (ship.py reads it).
@@ -17,7 +18,7 @@ import sys
 from unicross.metrics import wilson_interval
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-SEEDS = (4, 5, 6)
+SCREENS = {"I": ("_w10ship", (4, 5, 6)), "J": ("_w5ship", (7, 8, 9))}  # the export's tag, the training seeds
 EVAL_SEEDS = ("0", "1", "2", "3")
 spec = importlib.util.spec_from_file_location("judge3", os.path.join(HERE, "..", "student_xp_drift", "judge3.py"))
 judge3 = importlib.util.module_from_spec(spec)
@@ -30,8 +31,12 @@ def ci(k, n):
 
 
 if __name__ == "__main__":
-    cells_files = [os.path.join(HERE, f"student_cells_rep3_w10ship_s{s}.json") for s in SEEDS]
-    rot_files = [os.path.join(HERE, f"rotate_seeds_rep3_w10ship_s{s}.json") for s in SEEDS]
+    screen = sys.argv[1] if len(sys.argv) > 1 else "I"
+    if len(sys.argv) > 2 or screen not in SCREENS:
+        sys.exit(f"usage: python judge_i.py [SCREEN], SCREEN one of {', '.join(SCREENS)}")
+    tag, seeds = SCREENS[screen]
+    cells_files = [os.path.join(HERE, f"student_cells_rep3{tag}_s{s}.json") for s in seeds]
+    rot_files = [os.path.join(HERE, f"rotate_seeds_rep3{tag}_s{s}.json") for s in seeds]
     missing = [f for f in cells_files + rot_files if not os.path.exists(f)]
     if missing:
         sys.exit("missing: " + ", ".join(missing))
@@ -41,7 +46,7 @@ if __name__ == "__main__":
     shipped = json.load(open(os.path.join(HERE, "..", "translate_zm_reference", "thickness",
                                           "student_cells_seed0.json")))
     ok = True
-    print("| cell | seed 4 | seed 5 | seed 6 | student pooled [95% CI] | expert [95% CI] | bar | |")
+    print("| cell | " + " | ".join(f"seed {s}" for s in seeds) + " | student pooled [95% CI] | expert [95% CI] | bar | |")
     print("|---|---|---|---|---|---|---|---|")
     for name, (k, n) in pool.items():
         if name.startswith("rotate_"):
@@ -71,5 +76,5 @@ if __name__ == "__main__":
         ok &= good
         print(f"| {name} | " + " | ".join(f"{p:.1f}" for p in per) + f" | {ci(k, n)} | {expert} | >= {bar:.2f} | "
               f"{'ok' if good else 'MISSED'} |")
-    print(f"rule.txt I3: {'PASSED' if ok else 'FAILED'}")
+    print(f"rule.txt {screen}3: {'PASSED' if ok else 'FAILED'}")
     sys.exit(0 if ok else 1)
