@@ -13,6 +13,7 @@ def test_report_paper_one_trial(tmp_path):
                  "--out", str(out)]) == 0
     text = out.read_text()
     assert text.splitlines()[2].startswith("Command: `unicross report") and "--min-trials 0" in text.splitlines()[2]
+    assert text.splitlines()[6].startswith("Machine: ") and "step math " in text.splitlines()[6]
     for title in ("Experts, held-out test objects", "Student, held-out test objects", "Unseen objects",
                   "Disturbances", "Baselines", "Training budget of the shipped checkpoints", "Long horizon"):
         assert f"## {title}" in text
@@ -74,6 +75,17 @@ def test_report_paper_one_trial(tmp_path):
     n_rot = sum(m.startswith("rotate") for m in ships)
     if n_rot:  # the issue's rotate target is read off one pooled line under the experts' table
         assert f"Rotate, pooled over the {n_rot} axes with an expert (of 6): " in text
+
+
+def test_machine_line_names_the_step_math_mode(monkeypatch):
+    """The header line that a cell's reproduction needs follows the ``UNICROSS_COMPILE`` switch."""
+    from unicross.report import machine_line
+    monkeypatch.setenv("UNICROSS_COMPILE", "0")
+    assert "step math eager (`UNICROSS_COMPILE=0`)" in machine_line()
+    monkeypatch.setenv("UNICROSS_COMPILE", "1")
+    assert "step math compiled (`UNICROSS_COMPILE=1`)" in machine_line()
+    monkeypatch.setenv("UNICROSS_COMPILE", "torch")
+    assert "step math torch.compile" in machine_line()
 
 
 def test_report_raises_trials_to_the_minimum():

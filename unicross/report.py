@@ -8,13 +8,18 @@ command that regenerates the file is printed at its top.
 from __future__ import annotations
 
 import math
+import os
+import platform
 import shlex
 import time
 from pathlib import Path
 from typing import Callable, Dict, List, Optional
 
+import torch
+
 from unicross import evaluation as E
 from unicross import formulation as F
+from unicross.compiling import compile_enabled, compile_with_dynamo
 from unicross.objects import get_object_set
 from unicross.registry import mode_axis, skill_of_mode
 
@@ -71,6 +76,31 @@ def _scripted(clone_of: str) -> str:
 _ORIGIN_NAMES = {"residual": ("PPO on top of {}", ""),
                  "clone": ("DAgger clone of {}", " (its search not counted)"),
                  "ppo_from_clone": ("PPO from a DAgger clone of {}", " (the clone's frames not counted)")}
+
+
+def cpu_model() -> str:
+    """The CPU's model name (``/proc/cpuinfo``; ``platform.processor()`` elsewhere)."""
+    try:
+        with open("/proc/cpuinfo") as f:
+            for line in f:
+                if line.startswith("model name"):
+                    return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.processor() or "unknown CPU"
+
+
+def machine_line() -> str:
+    """The report's machine and step-math mode, which its cells need to repeat to the trial: the compiled and eager
+    step math differ by ~1e-8 per step (and Inductor's and ATen's kernels by CPU instruction set), and an in-hand
+    rotation can turn that into another outcome (docs/runs/student_l1/README.md, "Screen I")."""
+    switch = os.environ.get("UNICROSS_COMPILE", "1")
+    math_mode = "torch.compile" if compile_with_dynamo() else "compiled" if compile_enabled() else "eager"
+    return (f"Machine: {cpu_model()} ({torch.backends.cpu.get_cpu_capability()} kernels), {os.cpu_count()} cores, "
+            f"torch {torch.__version__}; step math {math_mode} "
+            f"(`UNICROSS_COMPILE={switch}`). The cells repeat to the trial on the same CPU and step-math mode; "
+            "elsewhere the step's rounding can change single trials (mostly in-hand rotations), within the cells' "
+            "intervals.")
 
 
 def policy_label(spec: str) -> str:
@@ -231,7 +261,7 @@ class PaperReport:
         if self.sim:
             lines[-1] += (" Physics: configs/task.yaml's sim section with " +
                           ", ".join(f"{k}={v}" for k, v in self.sim.items()) + " in every cell.")
-        lines.append("")
+        lines += ["", machine_line(), ""]
         self.log("experts on test objects ...")
         lines += self._table("Experts, held-out test objects", self._per_mode("test", False, "expert"), "Experts")
         lines += self._experts_pooled("test", False, "Experts")
