@@ -180,6 +180,8 @@ def test_finished_run_evaluates_on_held_out_objects_and_exports(tmp_path):
     side = json.loads(out.with_suffix(".json").read_text())
     assert side["commands"] == ["unicross train ..."] and side["evaluations"][0]["summaries"]["grasp"]["n"] == 4
     assert side["evaluations"][1]["summaries"] == side["evaluations"][0]["summaries"]
+    from unicross.report import cpu_model  # the CPU's model name (platform.processor() is empty on Linux)
+    assert side["hardware"]["processor"] == cpu_model() != ""
     policy, ck = load_policy(out)
     assert "optim" not in ck and ck["skill"] == "grasp" and out.stat().st_size < 3e6
 

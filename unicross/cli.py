@@ -256,13 +256,14 @@ def _cmd_export(args) -> int:
     import os
     import platform
     from unicross.evaluation import read_results
+    from unicross.report import cpu_model
     from unicross.rl.policy_io import export_policy
     run = Path(args.run)
     ckpt = run / "checkpoint.pt" if run.is_dir() else run
     if not ckpt.exists():
         raise FileNotFoundError(f"no checkpoint at {ckpt}")
     sidecar = dict(commands=args.command or [], hardware=dict(machine=platform.machine(), cpus=os.cpu_count(),
-                                                               processor=platform.processor() or None,
+                                                               processor=cpu_model(),
                                                                python=platform.python_version()))
     from unicross.rl.policy_io import read_torch_file
     ck = read_torch_file(ckpt, "checkpoint")
