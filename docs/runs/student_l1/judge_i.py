@@ -1,14 +1,16 @@
-"""rule.txt screens I (step I3) and J (J3): the three seeds' students against their experts, rotate cells over four
-evaluation seeds.
+"""rule.txt screens I (step I3), J (J3) and K (K3): the three seeds' students against their experts, rotate cells
+(and for K the long-horizon cells) over four evaluation seeds.
 
     python docs/runs/student_l1/judge_i.py [SCREEN] > docs/runs/student_l1/judge_<screen>.txt
 
 SCREEN (default I) names the students: I, x+ weight 10 on training seeds 4, 5, 6 (tag _w10ship); J, x+ weight 5 on
-seeds 7, 8, 9 (tag _w5ship). Rotate cells: the student's successes pooled over its three training seeds and evaluation
+seeds 7, 8, 9 (tag _w5ship); K, J's recipe on seeds 10, 11, 12. Rotate cells: the student's successes pooled over its three training seeds and evaluation
 seeds 0-3 (n = 1200; seed 0 from student_cells_rep3TAG_sS.json, 1-3 from rotate_seeds_rep3TAG_sS.json) against the mode's shipped
 expert over evaluation seeds 0-3 (rotate_seeds_experts.json, n = 400) minus 5 points. Every other cell as judge3.py:
 the evaluation-seed-0 cells pooled over the three students against docs/results.md's expert cell - 5 (grasp,
-relocate, translate) and the shipped student's long horizon - 5. The last line is PASSED or FAILED (ship.py reads it).
+relocate, translate) and the shipped student's long horizon - 5; for K each long-horizon cell is pooled as the rotate
+cells (seeds 1-3 from chain_seeds_rep3TAG_sS.json) against the shipped student over evaluation seeds 0-3
+(chain_seeds_shipped.json, n = 400) minus 5 points. The last line is PASSED or FAILED (ship.py reads it).
 """
 import importlib.util
 import json
@@ -18,7 +20,8 @@ import sys
 from unicross.metrics import wilson_interval
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-SCREENS = {"I": ("_w10ship", (4, 5, 6)), "J": ("_w5ship", (7, 8, 9))}  # the export's tag, the training seeds
+# the export's tag, the training seeds, whether the long horizon pools evaluation seeds 0-3
+SCREENS = {"I": ("_w10ship", (4, 5, 6), False), "J": ("_w5ship", (7, 8, 9), False), "K": ("_w5ship", (10, 11, 12), True)}
 EVAL_SEEDS = ("0", "1", "2", "3")
 spec = importlib.util.spec_from_file_location("judge3", os.path.join(HERE, "..", "student_xp_drift", "judge3.py"))
 judge3 = importlib.util.module_from_spec(spec)
@@ -34,15 +37,18 @@ if __name__ == "__main__":
     screen = sys.argv[1] if len(sys.argv) > 1 else "I"
     if len(sys.argv) > 2 or screen not in SCREENS:
         sys.exit(f"usage: python judge_i.py [SCREEN], SCREEN one of {', '.join(SCREENS)}")
-    tag, seeds = SCREENS[screen]
+    tag, seeds, chain_seeds = SCREENS[screen]
     cells_files = [os.path.join(HERE, f"student_cells_rep3{tag}_s{s}.json") for s in seeds]
     rot_files = [os.path.join(HERE, f"rotate_seeds_rep3{tag}_s{s}.json") for s in seeds]
-    missing = [f for f in cells_files + rot_files if not os.path.exists(f)]
+    chain_files = [os.path.join(HERE, f"chain_seeds_rep3{tag}_s{s}.json") for s in seeds] if chain_seeds else []
+    chain_files += [os.path.join(HERE, "chain_seeds_shipped.json")] if chain_seeds else []
+    missing = [f for f in cells_files + rot_files + chain_files if not os.path.exists(f)]
     if missing:
         sys.exit("missing: " + ", ".join(missing))
     experts = json.load(open(os.path.join(HERE, "rotate_seeds_experts.json")))["cells"]
     pool, cells = judge3.pooled(cells_files)
     rots = [json.load(open(f))["cells"] for f in rot_files]
+    chains = [json.load(open(f))["cells"] for f in chain_files]
     shipped = json.load(open(os.path.join(HERE, "..", "translate_zm_reference", "thickness",
                                           "student_cells_seed0.json")))
     ok = True
@@ -67,6 +73,20 @@ if __name__ == "__main__":
             per = [c["test"][name]["summary"]["sr"] for c in cells]
             expert = f"{judge3.EXPERT[name]:g} (n=100+, seed 0)"
             bar = judge3.EXPERT[name] - 5
+        elif chain_seeds:
+            ref = chains[-1][name]
+            measured = 100 * ref["0"]["successes"] / ref["0"]["n"]
+            docs = shipped["long_horizon"]["summary"][name]["overall"]["sr"]
+            if measured != docs:
+                print(f"note: {name}: the shipped student's seed-0 cell measured {measured:g}, recorded {docs:g}")
+            kr, nr = (sum(ref[e][f] for e in EVAL_SEEDS) for f in ("successes", "n"))
+            per_k, per_n = zip(*[[c["long_horizon"]["summary"][name]["overall"][f]
+                                  + sum(r[name][e][f] for e in EVAL_SEEDS[1:]) for f in ("successes", "n")]
+                                 for c, r in zip(cells, chains[:-1])])
+            k, n = sum(per_k), sum(per_n)
+            per = [100 * a / b for a, b in zip(per_k, per_n)]
+            expert = f"shipped student {ci(kr, nr)}"
+            bar = 100 * kr / nr - 5
         else:
             per = [c["long_horizon"]["summary"][name]["overall"]["sr"] for c in cells]
             ref = shipped["long_horizon"]["summary"][name]["overall"]["sr"]

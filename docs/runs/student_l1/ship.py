@@ -5,7 +5,7 @@ committed export, then rewrite the sidecar (the replaced record under ``replaced
     python docs/runs/student_l1/ship.py SCREEN [--dry]
 
 SCREEN is a key of ``SCREENS`` (G: x+ weight 10, seeds 1-3; H: x+ weight 15, seeds 1-3; I: G's recipe on seeds 4-6,
-rotate cells over evaluation seeds 0-3; J: I's judge, x+ weight 5, seeds 7-9; all x+ walked three times, l1 0.01, from the shipped student). It refuses to
+rotate cells over evaluation seeds 0-3; J: I's judge, x+ weight 5, seeds 7-9; K: J's recipe on seeds 10-12, long-horizon cells over evaluation seeds 0-3 too; all x+ walked three times, l1 0.01, from the shipped student). It refuses to
 write unless the screen's judge output (``judge_<screen>.txt``, e.g. judge_h.txt) ends in PASSED; ``--dry`` prints the new sidecar without writing anything. The stage command in the sidecar is
 common.sh's ``stage`` with ``ship_screen``'s arguments, as run_g.sh / run_h.sh call it.
 """
@@ -22,7 +22,8 @@ CK = "unicross/checkpoints/allegro/student"
 JUDGE3 = "python docs/runs/student_xp_drift/judge3.py {cells}"
 SCREENS = {"G": (10, (1, 2, 3), JUDGE3), "H": (15, (1, 2, 3), JUDGE3),
            "I": (10, (4, 5, 6), f"python {D}/judge_i.py   # also reads {D}/rotate_seeds_*.json"),
-           "J": (5, (7, 8, 9), f"python {D}/judge_i.py J   # also reads {D}/rotate_seeds_*.json")}
+           "J": (5, (7, 8, 9), f"python {D}/judge_i.py J   # also reads {D}/rotate_seeds_*.json"),
+           "K": (5, (10, 11, 12), f"python {D}/judge_i.py K   # also reads {D}/rotate_seeds_*.json, {D}/chain_seeds_*.json")}
 MODES = "grasp relocate rotate_x+ rotate_x- rotate_y+ rotate_y- rotate_z+ rotate_z- translate_z+ translate_z-"
 
 if __name__ == "__main__":
