@@ -66,6 +66,10 @@ def test_refuses_to_start_without_every_expert(tmp_path, experts):
     with pytest.raises(FileNotFoundError, match="env.grasp_dataset"):
         DAggerTrainer(tmp_path / "run3", experts, overrides=dict(env=dict(grasp_dataset=str(tmp_path / "none.pt"))),
                       progress=False)
+    # a chain count for a mode that has no chain (env.chain_repeats) is refused before any worker starts
+    with pytest.raises(ValueError, match="env.chain_repeats"):
+        DAggerTrainer(tmp_path / "run4", experts, overrides=dict(env=dict(chain_share=0.2, chain_repeats={"grasp": 2})),
+                      progress=False)
 
 
 def test_tiny_dagger_lowers_action_mse_on_every_mode(tmp_path, experts):
@@ -303,6 +307,16 @@ def test_mode_repeats_walk_a_mode_and_its_chains_k_times():
     assert [k["sequence"][-1] for _, k in chain_envs(kw, 0.2)].count("rotate_y+") == 2
     with pytest.raises(ValueError, match="not among"):
         walked_modes(["grasp", "relocate"], {"rotate_y+": 2})
+    # env.chain_repeats sets a chain's count over the walk's: the same list by default, k copies, 0 drops it
+    assert chain_envs(kw, 0.2, {}) == chain_envs(kw, 0.2)
+    tails = [k["sequence"][-1] for _, k in chain_envs(kw, 0.2, {"translate_z-": 3, "rotate_y+": 0, "rotate_x+": 1})]
+    assert tails.count("translate_z-") == 3 and "rotate_y+" not in tails and tails.count("rotate_x+") == 1
+    assert tails.count("rotate_z+") == 1 and len(tails) == 9
+    for bad, match in (({"grasp": 2}, "not among"), ({"translate_z-": -1}, "whole numbers"),
+                       ({"translate_z-": 1.5}, "whole numbers"),
+                       ({m: 0 for m in F.MODES if m.startswith(("rotate", "translate"))}, "leaves no chain")):
+        with pytest.raises(ValueError, match=match):
+            chain_envs(kw, 0.2, bad)
     for bad in (0, 1.5, True):
         with pytest.raises(ValueError, match="whole numbers"):
             walked_modes(F.MODES, {"rotate_y+": bad})

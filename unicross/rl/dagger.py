@@ -69,21 +69,35 @@ def walked_modes(modes: Sequence[str], repeats: Optional[Dict[str, int]]) -> lis
     return [m for m in modes for _ in range(repeats.get(m, 1))]
 
 
-def chain_envs(multi_kwargs: dict, share: float) -> list:
+def chain_envs(multi_kwargs: dict, share: float, repeats: Optional[Dict[str, int]] = None) -> list:
     """``env.chain_share``: the long-horizon chains the student also acts in, as ``(env_id, kwargs)``
-    alternates of the multi-skill env (:class:`unicross.rl.collector.Rollout`): grasp, relocate, then
-    each rotate or translate mode of the run's modes (the paper's Gr.+Re.+Rot. / Gr.+Re.+Trans. sequences, one per
-    axis), on the multi-skill env's objects (default: the training set) and settings. Empty for a
-    share of 0; refused when the modes lack grasp, relocate or any rotate or translate mode."""
+    alternates of the multi-skill env (:class:`unicross.rl.collector.Rollout`, which draws one uniformly): grasp,
+    relocate, then each rotate or translate mode of the run's modes (the paper's Gr.+Re.+Rot. / Gr.+Re.+Trans.
+    sequences, one per axis; a mode the walk repeats, ``env.mode_repeats``, as many times), on the multi-skill env's
+    objects (default: the training set) and settings. ``repeats`` (``env.chain_repeats``, ``{mode: k}``) sets how
+    many times the chain of ``m`` is listed instead (0 leaves it out), so it is drawn ``k`` times as often. Empty for
+    a share of 0; refused when the modes lack grasp, relocate or any rotate or translate mode, or when ``repeats``
+    names another mode, is not a whole number >= 0, or leaves no chain."""
     if not 0.0 <= share <= 1.0:
         raise ValueError(f"env.chain_share must be in [0, 1], got {share}")
     if share == 0.0:
         return []
     modes = list(multi_kwargs["modes"])
-    tails = [m for m in modes if R.skill_of_mode(m).accumulates]  # rotate, translate
-    if "grasp" not in modes or "relocate" not in modes or not tails:
+    walked = [m for m in modes if R.skill_of_mode(m).accumulates]  # rotate, translate
+    if "grasp" not in modes or "relocate" not in modes or not walked:
         raise ValueError(f"env.chain_share > 0 needs grasp, relocate and a rotate or translate mode among env.modes, "
                          f"got {modes}")
+    repeats = dict(repeats or {})
+    unknown = sorted(set(repeats) - set(walked))
+    if unknown:
+        raise ValueError(f"env.chain_repeats: {unknown} not among the run's rotate and translate modes "
+                         f"{sorted(set(walked))}")
+    bad = {m: k for m, k in repeats.items() if not isinstance(k, int) or isinstance(k, bool) or k < 0}
+    if bad:
+        raise ValueError(f"env.chain_repeats: repeats are whole numbers >= 0, got {bad}")
+    tails = [m for m in dict.fromkeys(walked) for _ in range(repeats.get(m, walked.count(m)))]
+    if not tails:
+        raise ValueError(f"env.chain_repeats={repeats} leaves no chain; set env.chain_share=0 for none")
     kw = {k: v for k, v in multi_kwargs.items() if k not in ("modes", "grasp_dataset")}
     kw.setdefault("objects", "train")
     return [("UniCross-Chain-v1", dict(kw, sequence=["grasp", "relocate", m])) for m in tails]
@@ -219,7 +233,8 @@ class DAggerTrainer(Runner):
         chain_share = float(ec.get("chain_share") or 0.0)
         self.collector = make_collector("UniCross-MultiSkill-v1", kw, num_envs, cfg["collector"]["rollout_steps"], seed,
                                         ec["backend"], ray_address, deterministic=True,
-                                        alternates=chain_envs(kw, chain_share), alternate_share=chain_share)
+                                        alternates=chain_envs(kw, chain_share, ec.get("chain_repeats")),
+                                        alternate_share=chain_share)
         self.dims, self.n_act = self.collector.dims, self.collector.n_act
         self.student, _, self.norm = make_models(self.dims, self.n_act, Bounded(-1.0, 1.0, (self.n_act,)),
                                                  cfg["model"])
