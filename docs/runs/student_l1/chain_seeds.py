@@ -10,8 +10,8 @@ cell, successes, n (the chain's overall success: every phase done).
 import argparse
 import json
 
+from rotate_seeds import report_at  # this folder (the script's own directory is on sys.path)
 from unicross.evaluation import resolve_policy
-from unicross.report import PaperReport
 
 
 def chain_cells(spec, seeds):
@@ -19,7 +19,7 @@ def chain_cells(spec, seeds):
     policy = resolve_policy(spec, "allegro")[0]
     out = {}
     for seed in seeds:
-        rep = PaperReport(hand="allegro", limit=10, trials=3, workers=2, seed=seed, min_trials=100)
+        rep = report_at(seed)
         print("\n".join(rep.chain("policy", policy)), flush=True)
         for chain, s in rep.chain_summaries["policy"]["summary"].items():
             o = s["overall"]

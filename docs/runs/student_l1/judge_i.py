@@ -33,6 +33,16 @@ def ci(k, n):
     return f"{100 * k / n:.1f} [{lo:.1f}-{hi:.1f}] (n={n})"
 
 
+def over_seeds(ref, seed0, rest):
+    """A cell pooled over evaluation seeds 0-3: ``ref`` the reference's {seed: {successes, n}}; per student its
+    seed-0 summary (``seed0``, the report's cell) and its {seed: {successes, n}} of seeds 1-3 (``rest``). Returns
+    the students' pooled successes and n, each student's rate and the reference's (successes, n)."""
+    per_k, per_n = zip(*[[s[f] + sum(r[e][f] for e in EVAL_SEEDS[1:]) for f in ("successes", "n")]
+                         for s, r in zip(seed0, rest)])
+    kr, nr = (sum(ref[e][f] for e in EVAL_SEEDS) for f in ("successes", "n"))
+    return sum(per_k), sum(per_n), [100 * a / b for a, b in zip(per_k, per_n)], (kr, nr)
+
+
 if __name__ == "__main__":
     screen = sys.argv[1] if len(sys.argv) > 1 else "I"
     if len(sys.argv) > 2 or screen not in SCREENS:
@@ -61,12 +71,7 @@ if __name__ == "__main__":
             if measured != judge3.EXPERT[name]:
                 print(f"note: {name}: the expert's seed-0 cell measured {measured:g}, "
                       f"docs/results.md {judge3.EXPERT[name]:g}")
-            ke, ne = (sum(ex[e][f] for e in EVAL_SEEDS) for f in ("successes", "n"))
-            # per student: (successes, n) of evaluation seed 0 (the report's cell) and seeds 1-3
-            per_k, per_n = zip(*[[c["test"][name]["summary"][f] + sum(r[name][e][f] for e in EVAL_SEEDS[1:])
-                                  for f in ("successes", "n")] for c, r in zip(cells, rots)])
-            k, n = sum(per_k), sum(per_n)
-            per = [100 * a / b for a, b in zip(per_k, per_n)]
+            k, n, per, (ke, ne) = over_seeds(ex, [c["test"][name]["summary"] for c in cells], [r[name] for r in rots])
             expert = ci(ke, ne)
             bar = 100 * ke / ne - 5
         elif name in judge3.EXPERT:
@@ -79,12 +84,8 @@ if __name__ == "__main__":
             docs = shipped["long_horizon"]["summary"][name]["overall"]["sr"]
             if measured != docs:
                 print(f"note: {name}: the shipped student's seed-0 cell measured {measured:g}, recorded {docs:g}")
-            kr, nr = (sum(ref[e][f] for e in EVAL_SEEDS) for f in ("successes", "n"))
-            per_k, per_n = zip(*[[c["long_horizon"]["summary"][name]["overall"][f]
-                                  + sum(r[name][e][f] for e in EVAL_SEEDS[1:]) for f in ("successes", "n")]
-                                 for c, r in zip(cells, chains[:-1])])
-            k, n = sum(per_k), sum(per_n)
-            per = [100 * a / b for a, b in zip(per_k, per_n)]
+            k, n, per, (kr, nr) = over_seeds(ref, [c["long_horizon"]["summary"][name]["overall"] for c in cells],
+                                             [r[name] for r in chains[:-1]])
             expert = f"shipped student {ci(kr, nr)}"
             bar = 100 * kr / nr - 5
         else:

@@ -16,13 +16,19 @@ from unicross.report import PaperReport
 ROTATE = [m for m in F.MODES if m.startswith("rotate_")]
 
 
+def report_at(seed, workers=2):
+    """The report's protocol (docs/results.md's cells: ``PaperReport(limit=10, trials=3, min_trials=100)``) under
+    evaluation seed ``seed``."""
+    return PaperReport(hand="allegro", limit=10, trials=3, workers=workers, seed=seed, min_trials=100)
+
+
 def seed_cells(spec, modes, seeds, workers=2):
     """{mode: {seed: dict(cell, successes, n)}} for ``spec`` (``experts``: ``allegro/<mode>`` per mode)."""
     out = {}
     for mode in modes:
         policy = f"allegro/{mode}" if spec == "experts" else spec
         for seed in seeds:
-            rep = PaperReport(hand="allegro", limit=10, trials=3, workers=workers, seed=seed, min_trials=100)
+            rep = report_at(seed, workers)
             cell = rep.evaluate(mode, policy, "test")
             s = rep.summaries[(mode, policy, "test", False)]
             out.setdefault(mode, {})[seed] = dict(cell=cell, successes=s["successes"], n=s["n"])
