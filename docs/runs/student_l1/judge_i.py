@@ -1,16 +1,19 @@
-"""rule.txt screens I (step I3), J (J3) and K (K3): the three seeds' students against their experts, rotate cells
-(and for K the long-horizon cells) over four evaluation seeds.
+"""rule.txt screens I (step I3), J (J3), K (K3) and L (L3): the three seeds' students against their experts, rotate
+cells (and for K and L the long-horizon cells) over four evaluation seeds.
 
     python docs/runs/student_l1/judge_i.py [SCREEN] > docs/runs/student_l1/judge_<screen>.txt
 
 SCREEN (default I) names the students: I, x+ weight 10 on training seeds 4, 5, 6 (tag _w10ship); J, x+ weight 5 on
-seeds 7, 8, 9 (tag _w5ship); K, J's recipe on seeds 10, 11, 12. Rotate cells: the student's successes pooled over its three training seeds and evaluation
+seeds 7, 8, 9 (tag _w5ship); K, J's recipe on seeds 10, 11, 12; L, K's with env.chain_repeats={rotate_x+: 1,
+translate_z-: 3} on seeds 13, 14, 15 (tag _chz). Rotate cells: the student's successes pooled over its three training seeds and evaluation
 seeds 0-3 (n = 1200; seed 0 from student_cells_rep3TAG_sS.json, 1-3 from rotate_seeds_rep3TAG_sS.json) against the mode's shipped
 expert over evaluation seeds 0-3 (rotate_seeds_experts.json, n = 400) minus 5 points. Every other cell as judge3.py:
 the evaluation-seed-0 cells pooled over the three students against docs/results.md's expert cell - 5 (grasp,
 relocate, translate) and the shipped student's long horizon - 5; for K each long-horizon cell is pooled as the rotate
 cells (seeds 1-3 from chain_seeds_rep3TAG_sS.json) against the shipped student over evaluation seeds 0-3
-(chain_seeds_shipped.json, n = 400) minus 5 points. The last line is PASSED or FAILED (ship.py reads it).
+(chain_seeds_shipped.json, n = 400) minus 5 points; for L against K's seed 10, shipped since (its seed-0 cells and
+chain_seeds_rep3_w5ship_s10.json, n = 400) minus 5 points, and L passes only when its pooled Gr. + Re. + Trans. also
+has its 95% lower bound above that student's rate (L3: a gain). The last line is PASSED or FAILED (ship.py reads it).
 """
 import importlib.util
 import json
@@ -21,7 +24,11 @@ from unicross.metrics import wilson_interval
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 # the export's tag, the training seeds, whether the long horizon pools evaluation seeds 0-3
-SCREENS = {"I": ("_w10ship", (4, 5, 6), False), "J": ("_w5ship", (7, 8, 9), False), "K": ("_w5ship", (10, 11, 12), True)}
+SCREENS = {"I": ("_w10ship", (4, 5, 6), False), "J": ("_w5ship", (7, 8, 9), False), "K": ("_w5ship", (10, 11, 12), True),
+           "L": ("_chz", (13, 14, 15), True)}
+# L's long-horizon reference: K's seed 10 (shipped by K), its evaluation-seed-0 cells and seeds 1-3
+L_REF = ("student_cells_rep3_w5ship_s10.json", "chain_seeds_rep3_w5ship_s10.json")
+GAIN = "Gr. + Re. + Trans."  # L3: the chain that must gain
 EVAL_SEEDS = ("0", "1", "2", "3")
 spec = importlib.util.spec_from_file_location("judge3", os.path.join(HERE, "..", "student_xp_drift", "judge3.py"))
 judge3 = importlib.util.module_from_spec(spec)
@@ -51,14 +58,23 @@ if __name__ == "__main__":
     cells_files = [os.path.join(HERE, f"student_cells_rep3{tag}_s{s}.json") for s in seeds]
     rot_files = [os.path.join(HERE, f"rotate_seeds_rep3{tag}_s{s}.json") for s in seeds]
     chain_files = [os.path.join(HERE, f"chain_seeds_rep3{tag}_s{s}.json") for s in seeds] if chain_seeds else []
-    chain_files += [os.path.join(HERE, "chain_seeds_shipped.json")] if chain_seeds else []
+    refs = list(L_REF) if screen == "L" else ["chain_seeds_shipped.json"]
+    chain_files += [os.path.join(HERE, f) for f in refs] if chain_seeds else []
     missing = [f for f in cells_files + rot_files + chain_files if not os.path.exists(f)]
     if missing:
         sys.exit("missing: " + ", ".join(missing))
     experts = json.load(open(os.path.join(HERE, "rotate_seeds_experts.json")))["cells"]
     pool, cells = judge3.pooled(cells_files)
     rots = [json.load(open(f))["cells"] for f in rot_files]
-    chains = [json.load(open(f))["cells"] for f in chain_files]
+    chains = [json.load(open(f)) for f in chain_files]
+    if screen == "L":  # the reference's seed-0 cells from its report cells, seeds 1-3 from its chain_seeds file
+        seed0, rest = chains[-2:]
+        chains = chains[:-2] + [{c: {"0": seed0["long_horizon"]["summary"][c]["overall"], **rest["cells"][c]}
+                                 for c in rest["cells"]}]
+        chains = [c.get("cells", c) for c in chains]
+    else:
+        chains = [c["cells"] for c in chains]
+    gain = None
     shipped = json.load(open(os.path.join(HERE, "..", "translate_zm_reference", "thickness",
                                           "student_cells_seed0.json")))
     ok = True
@@ -82,12 +98,14 @@ if __name__ == "__main__":
             ref = chains[-1][name]
             measured = 100 * ref["0"]["successes"] / ref["0"]["n"]
             docs = shipped["long_horizon"]["summary"][name]["overall"]["sr"]
-            if measured != docs:
+            if screen == "K" and measured != docs:
                 print(f"note: {name}: the shipped student's seed-0 cell measured {measured:g}, recorded {docs:g}")
             k, n, per, (kr, nr) = over_seeds(ref, [c["long_horizon"]["summary"][name]["overall"] for c in cells],
                                              [r[name] for r in chains[:-1]])
             expert = f"shipped student {ci(kr, nr)}"
             bar = 100 * kr / nr - 5
+            if screen == "L" and name == GAIN:
+                gain = (100 * wilson_interval(k, n)[0], 100 * kr / nr)
         else:
             per = [c["long_horizon"]["summary"][name]["overall"]["sr"] for c in cells]
             ref = shipped["long_horizon"]["summary"][name]["overall"]["sr"]
@@ -97,5 +115,10 @@ if __name__ == "__main__":
         ok &= good
         print(f"| {name} | " + " | ".join(f"{p:.1f}" for p in per) + f" | {ci(k, n)} | {expert} | >= {bar:.2f} | "
               f"{'ok' if good else 'MISSED'} |")
+    if gain is not None:
+        lo, rate = gain
+        print(f"L3 gain: {GAIN} pooled lower bound {lo:.2f} {'>' if lo > rate else '<='} the shipped student's "
+              f"{rate:.2f}: {'ok' if lo > rate else 'MISSED'}")
+        ok &= lo > rate
     print(f"rule.txt {screen}3: {'PASSED' if ok else 'FAILED'}")
     sys.exit(0 if ok else 1)
