@@ -5,7 +5,8 @@ committed export, then rewrite the sidecar (the replaced record under ``replaced
     python docs/runs/student_l1/ship.py SCREEN [--dry]
 
 SCREEN is a key of ``SCREENS`` (G: x+ weight 10, seeds 1-3; H: x+ weight 15, seeds 1-3; I: G's recipe on seeds 4-6,
-rotate cells over evaluation seeds 0-3; J: I's judge, x+ weight 5, seeds 7-9; K: J's recipe on seeds 10-12, long-horizon cells over evaluation seeds 0-3 too; all x+ walked three times, l1 0.01, from the shipped student). It refuses to
+rotate cells over evaluation seeds 0-3; J: I's judge, x+ weight 5, seeds 7-9; K: J's recipe on seeds 10-12, long-horizon cells over evaluation seeds 0-3 too; all x+ walked three times, l1 0.01, from the shipped student;
+L: K's with env.chain_repeats={rotate_x+: 1, translate_z-: 3} on seeds 13-15, from K's initial student, tag _chz). It refuses to
 write unless the screen's judge output (``judge_<screen>.txt``, e.g. judge_h.txt) ends in PASSED; ``--dry`` prints the new sidecar without writing anything. The stage command in the sidecar is
 common.sh's ``stage`` with ``ship_screen``'s arguments, as run_g.sh / run_h.sh call it.
 """
@@ -23,7 +24,14 @@ JUDGE3 = "python docs/runs/student_xp_drift/judge3.py {cells}"
 SCREENS = {"G": (10, (1, 2, 3), JUDGE3), "H": (15, (1, 2, 3), JUDGE3),
            "I": (10, (4, 5, 6), f"python {D}/judge_i.py   # also reads {D}/rotate_seeds_*.json"),
            "J": (5, (7, 8, 9), f"python {D}/judge_i.py J   # also reads {D}/rotate_seeds_*.json"),
-           "K": (5, (10, 11, 12), f"python {D}/judge_i.py K   # also reads {D}/rotate_seeds_*.json, {D}/chain_seeds_*.json")}
+           "K": (5, (10, 11, 12), f"python {D}/judge_i.py K   # also reads {D}/rotate_seeds_*.json, {D}/chain_seeds_*.json"),
+           "L": (5, (13, 14, 15), f"python {D}/judge_i.py L   # also reads {D}/rotate_seeds_*.json, {D}/chain_seeds_*.json")}
+# screens whose export tag and stage differ from ship_screen's (run_l.sh): the tag, the stage's last arguments and
+# the command that makes their initial student, which is the shipped student's own initial one (its ``replaced``)
+OTHER_STAGE = {"L": ("_chz", "--set model.init_policy=runs/student_pre_k.pt "
+                             "--set 'env.chain_repeats={{rotate_x+: 1, translate_z-: 3}}'",
+                     "git show 06e213f^:unicross/checkpoints/allegro/student.pt > runs/student_pre_k.pt   "
+                     "# K's initial student (run_l.sh)")}
 MODES = "grasp relocate rotate_x+ rotate_x- rotate_y+ rotate_y- rotate_z+ rotate_z- translate_z+ translate_z-"
 
 if __name__ == "__main__":
@@ -33,7 +41,7 @@ if __name__ == "__main__":
         sys.exit(f"usage: python {D}/ship.py SCREEN [--dry], SCREEN one of {', '.join(SCREENS)}")
     name = args[0]
     weight, (ship_seed, *others), judge_cmd = SCREENS[name]
-    tag = f"_w{weight}ship"
+    tag, extra, init_cmd = OTHER_STAGE.get(name, (f"_w{weight}ship", "", None))
     run = f"runs/l1rep3{tag.strip('_')}_s{{s}}"
     export = f"{D}/student_l1_rep3{tag}_s{{s}}"
     cells_of = f"{D}/student_cells_rep3{tag}_s{{s}}.json"
@@ -46,8 +54,9 @@ if __name__ == "__main__":
     if verdict != "PASSED" and not dry:
         sys.exit(f"{judge}: {verdict}; screen {name} does not ship (rule.txt screen {name})")
     old = json.load(open(f"{CK}.json"))
-    if old.get("rule", "").startswith(D):  # run again after shipping: keep the record it replaced
-        old = old["replaced"]
+    if old.get("rule", "").startswith(f"{D}/rule.txt screen {name} "):  # run again after shipping: keep the record
+        old = old["replaced"]                                              # it replaced
+    base = old["replaced"] if init_cmd else old  # the initial student's record: the lineage's commands and frames
     ck = torch.load(f"{export.format(s=ship_seed)}.pt", map_location="cpu", weights_only=False)
     wall_s = json.load(open(f"{export.format(s=ship_seed)}.json"))["train_wall_s"]  # the stage's, from the export's sidecar
     stage = ("unicross distill --experts runs/experts1205x --out " + run + " --epochs 1500 "
@@ -57,13 +66,15 @@ if __name__ == "__main__":
              "--set logging.checkpoint_every=25 --set seed={s} --set env.chain_share=0.15 "
              "--set 'optim.mode_weights={{rotate_x+: 30}}' --set optim.l1=0.01 "
              "--set 'env.mode_repeats={{rotate_x+: 3}}' "
-             f"--set 'optim.mode_weights={{{{rotate_x+: {weight}}}}}' --set model.init_policy=allegro/student")
-    commands = old["commands"] + [
+             f"--set 'optim.mode_weights={{{{rotate_x+: {weight}}}}}' --set model.init_policy=allegro/student"
+             + (" " + extra if extra else ""))
+    commands = base["commands"] + ([init_cmd] if init_cmd else []) + [
         f"mkdir -p runs/experts1205x; for m in {MODES}; do mkdir -p runs/experts1205x/$m; "
         "cp unicross/checkpoints/allegro/$m.pt runs/experts1205x/$m/checkpoint.pt; done   # the ten shipped experts "
         f"of commit fe6c582 (rotate x+ = the clone of the x+ finger sequence); {D}/common.sh: experts_dir",
         stage.format(s=ship_seed) + f"   # commit {ck['git_commit'][:7]}, {wall_s / 60:.0f} min on 2 cores ({D}/rule.txt "
-        f"screen {name}; later --set values override earlier ones: init = the student this replaces, "
+        f"screen {name}; later --set values override earlier ones: init = "
+        f"{'runs/student_pre_k.pt, the initial student of the one this replaces' if init_cmd else 'the student this replaces'}, "
         f"x+ weight {weight})",
         f"unicross export {run.format(s=ship_seed)} --out {export.format(s=ship_seed)}.pt",
         f"python docs/runs/student_ft_1202b/seed_cells.py {export.format(s=ship_seed)}.pt "
@@ -86,14 +97,16 @@ if __name__ == "__main__":
         seeds.append(dict(seed=s, command=stage.format(s=s) + f" (export {export.format(s=s)}.pt); judged pooled "
                           f"with seed {ship_seed}, not chosen on", test_cells=test_cells(c), long_horizon_overall=overall(c)))
     new = dict(
-        skill=ck["skill"], axis=ck["axis"], hand=ck["hand"], epoch=ck["epoch"], frames=old["frames"] + ck["frames"],
+        skill=ck["skill"], axis=ck["axis"], hand=ck["hand"], epoch=ck["epoch"], frames=base["frames"] + ck["frames"],
         distilled_modes=ck["distilled_modes"], git_commit=ck["git_commit"],
-        commits=old["commits"] + [ck["git_commit"]], commands=commands, hardware=old["hardware"],
-        train_wall_s=round(old["train_wall_s"] + wall_s, 1), stage_frames=ck["frames"], stage_wall_s=round(wall_s, 1),
-        frames_note="frames and train_wall_s count every stage from the first DAgger run: the student this replaces "
-                    f"({old['frames']} frames, {old['train_wall_s']} s; its own frames_note under replaced) and this "
+        commits=base["commits"] + [ck["git_commit"]], commands=commands, hardware=base["hardware"],
+        train_wall_s=round(base["train_wall_s"] + wall_s, 1), stage_frames=ck["frames"], stage_wall_s=round(wall_s, 1),
+        frames_note="frames and train_wall_s count every stage from the first DAgger run: the student this stage "
+                    f"started from ({base['frames']} frames, {base['train_wall_s']} s; its own frames_note under "
+                    f"replaced{'.replaced' if init_cmd else ''}) and this "
                     f"stage (stage_frames, stage_wall_s: rotate x+ walked three times with weight {weight}, l1 0.01, "
-                    "env.chain_share 0.15, on the ten shipped experts)",
+                    f"env.chain_share 0.15{' (chain_repeats: the stage command)' if extra else ''}, on the ten "
+                    "shipped experts)",
         rule=f"{D}/rule.txt screen {name} (three seeds pooled, {judge_cmd.split()[1]}; seed {ship_seed} named "
              "before the runs)",
         teachers="the ten Allegro experts shipped at commit fe6c582 (rotate x+ = the clone of the x+ finger sequence)",
