@@ -68,12 +68,10 @@ if __name__ == "__main__":
     rots = [json.load(open(f))["cells"] for f in rot_files]
     chains = [json.load(open(f)) for f in chain_files]
     if screen == "L":  # the reference's seed-0 cells from its report cells, seeds 1-3 from its chain_seeds file
-        seed0, rest = chains[-2:]
-        chains = chains[:-2] + [{c: {"0": seed0["long_horizon"]["summary"][c]["overall"], **rest["cells"][c]}
-                                 for c in rest["cells"]}]
-        chains = [c.get("cells", c) for c in chains]
-    else:
-        chains = [c["cells"] for c in chains]
+        seed0, rest = chains.pop(-2), chains.pop()
+        chains.append({c: {"0": seed0["long_horizon"]["summary"][c]["overall"], **rest["cells"][c]}
+                       for c in rest["cells"]})
+    chains = [c.get("cells", c) for c in chains]
     gain = None
     shipped = json.load(open(os.path.join(HERE, "..", "translate_zm_reference", "thickness",
                                           "student_cells_seed0.json")))
