@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Steps 1-3 of rule.txt: the two z- searches (A from the z+ gaits reversed, B from the z- gaits), then the clone of
-# the candidate (step 2 picks it: pick.py). Re-running skips what exists. ~25 min of searches + ~10 of clone, 2 cores.
+# the candidate (step 2 picks it: pick.py; clone.sh). Re-running skips what exists. ~25 min of searches + ~10 of clone, 2 cores.
 set -euo pipefail
 cd "$(dirname "$0")/../../.."
 D=docs/runs/rotate_zm_it12
@@ -15,8 +15,4 @@ COMMON=(--skill rotate --axis z- --refine z- --hold --no-stop --tracking phase -
 gzip -kf runs/gait/rotate_z-_it12_A.jsonl runs/gait/rotate_z-_it12_B.jsonl
 cp runs/gait/rotate_z-_it12_A.jsonl.gz runs/gait/rotate_z-_it12_B.jsonl.gz $D/
 python $D/pick.py $D/rotate_z-_it12_A.jsonl.gz $D/rotate_z-_it12_B.jsonl.gz --out $D/candidate.json || exit 0
-LOG=$(python -c "import json; print(json.load(open('$D/candidate.json'))['log'])")
-[ -s runs/clone/zm_it12/policy.pt ] || python benchmarks/gait_clone.py --gait "$LOG" --limit 8 --trials 2 --rounds 8 \
-    --beta 0.5 --obs-std-min 1e-2 --heldout 20 --seed 0 --out runs/clone/zm_it12 > $D/clone.log 2>&1
-[ -s $D/shipped_test120 ] || unicross eval --policy allegro/rotate_z- --protocol rotate --axis z- --objects test \
-    --limit 20 --trials-per-object 3 --seed 0 --workers 2 --out $D/shipped_test120 > $D/shipped_eval.log 2>&1
+bash $D/clone.sh "$(python -c "import json; print(json.load(open('$D/candidate.json'))['log'])")"

@@ -11,7 +11,4 @@ INIT=$(python -c "import json; print(json.load(open('$D/candidate.json'))['log']
     > $D/search_2.log 2>&1
 gzip -kf runs/gait/rotate_z-_it12_2.jsonl && cp runs/gait/rotate_z-_it12_2.jsonl.gz $D/
 python $D/pick.py $D/rotate_z-_it12_2.jsonl.gz --out $D/candidate_2.json || exit 0
-[ -s runs/clone/zm_it12/policy.pt ] || python benchmarks/gait_clone.py --gait $D/rotate_z-_it12_2.jsonl.gz --limit 8 \
-    --trials 2 --rounds 8 --beta 0.5 --obs-std-min 1e-2 --heldout 20 --seed 0 --out runs/clone/zm_it12 > $D/clone.log 2>&1
-[ -s $D/shipped_test120 ] || unicross eval --policy allegro/rotate_z- --protocol rotate --axis z- --objects test \
-    --limit 20 --trials-per-object 3 --seed 0 --workers 2 --out $D/shipped_test120 > $D/shipped_eval.log 2>&1
+bash $D/clone.sh $D/rotate_z-_it12_2.jsonl.gz
