@@ -1,0 +1,65 @@
+"""Ship the clone of an axis's gait searched under 12 iterations as allegro/rotate_AX (rule.txt step 4): copy its
+policy and write the sidecar (the searches' commands, the held-out cells), the replaced record kept under
+``replaced``. Refuses when the rule's paired interval (paired.txt, written by run.sh) does not lie above 0.
+
+    python docs/runs/rotate_axes_it12/ship.py x- [--dry]
+"""
+import json
+import re
+import shutil
+import sys
+
+import torch
+
+from unicross.evaluation import read_results
+
+AX = sys.argv[1]
+D = f"docs/runs/rotate_axes_it12/{AX}"
+RUN = f"runs/clone/{AX}_it12"
+CK = f"unicross/checkpoints/allegro/rotate_{AX}"
+HELDOUT = f"--protocol rotate --axis {AX} --objects test --limit 20 --trials-per-object 3 --seed 0 --workers 2"
+
+paired = open(f"{D}/paired.txt").read()
+low = float(re.search(r"\[([+-]?[\d.]+),", paired.split("difference", 1)[-1]).group(1))
+if low <= 0 and "--force-record" not in sys.argv:
+    raise SystemExit(f"rule step 4: the paired interval's lower end is {low:+.1f}, not above 0; nothing ships")
+candidate = json.load(open(f"{D}/candidate.json"))
+ck = torch.load(f"{RUN}/policy.pt", map_location="cpu", weights_only=False)
+assert ck["clone_of"] == candidate["log"], f"{RUN} is not a clone of {candidate['log']}"
+old = json.load(open(f"{CK}.json"))
+if old["clone_of"] == ck["clone_of"]:  # run again after shipping: keep the record it replaced
+    old = old["replaced"]
+
+
+def evaluation(path):
+    return dict(file=path, objects="test", limit=20, trials_per_object=3, seed=0, summaries=read_results(path)["summaries"])
+
+
+new = dict(
+    skill="rotate", axis=AX, hand="allegro", iteration=0, frames=ck["frames"], git_commit=ck["git_commit"],
+    commits=ck["commits"], clone_of=ck["clone_of"], kind="dagger clone of a scripted gait",
+    commands=[
+        f"bash docs/runs/rotate_axes_it12/run.sh {AX}   # searches A (the opposite axis's gaits run backwards), B (the "
+        f"axis's own) and 2 (a second round from the better), the candidate {candidate['log']} (selection "
+        f"{candidate['success']:.3f} of {candidate.get('selection_episodes')}), its clone and the held-out cells; "
+        f"logs {D}/search_{{A,B,2}}.log",
+        open(f"{RUN}/command.txt").read().strip() + f"   # log {D}/clone_s0/log.jsonl",
+        f"unicross eval --policy {RUN}/policy.pt {HELDOUT} --out {D}/clone_s0_test120",
+        f"python docs/runs/paper_protocol/paired.py {D}/clone_s0_test120 {D}/shipped_test120 --skill rotate   "
+        f"# {D}/paired.txt",
+    ],
+    hardware=old["hardware"], train_wall_s=ck["wall_s"],
+    frames_note="control steps simulated over the clone's 8 DAgger rounds (the sum of new_states in its log.jsonl); "
+                "the gait's searches are not counted",
+    shipping_rule="docs/runs/rotate_axes_it12/rule.txt",
+    evaluations=[evaluation(f"{D}/clone_s0_test120")],
+    baselines={"the expert it replaces (12 iterations, this machine)": evaluation(f"{D}/shipped_test120")},
+    replaced_because=f"on the rule's 120 held-out trials, paired by trial against the replaced expert: {paired.strip()}",
+    replaced=old,
+)
+if "--dry" in sys.argv:
+    print(json.dumps({k: v for k, v in new.items() if k != "replaced"}, indent=1)[:3000])
+else:
+    shutil.copy(f"{RUN}/policy.pt", f"{CK}.pt")
+    json.dump(new, open(f"{CK}.json", "w"), indent=1)
+    print(f"wrote {CK}.pt and {CK}.json")
