@@ -4,6 +4,9 @@ difference with its 95% interval (paired, Newcombe's method 10 from the two Wils
 correlation of the pairs) and the exact McNemar p (two-sided binomial test on the discordant pairs).
 
     python docs/runs/paper_protocol/paired.py A.json[.gz] B.json[.gz] [--skill translate]
+
+Either side may be several evaluations joined by commas (e.g. the same cell under evaluation seeds 1, 2 and 3,
+``A1,A2,A3 B1,B2,B3``): their trials are pooled (a trial is keyed by object, axis, trial and seed).
 """
 import argparse
 import math
@@ -47,21 +50,23 @@ def newcombe_paired(a, b, c, d, z=1.96):
 
 def main():
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("first")
-    p.add_argument("second")
+    p.add_argument("first", help="an evaluation (results file or folder), or several joined by commas")
+    p.add_argument("second", help="the same, of the other policy")
     p.add_argument("--skill", default=None, help="the protocol's key in 'trials' (default: the only one)")
     args = p.parse_args()
-    runs = [read_results(args.first), read_results(args.second)]
-    skill = args.skill or next(iter(runs[0]["trials"]))
+    runs = [[read_results(f) for f in side.split(",")] for side in (args.first, args.second)]
+    skill = args.skill or next(iter(runs[0][0]["trials"]))
     key = ("object", "axis", "trial", "seed")
-    trials = [{tuple(t[k] for k in key): t["success"] for t in r["trials"][skill]} for r in runs]
+    trials = [{tuple(t[k] for k in key): t["success"] for r in side for t in r["trials"][skill]} for side in runs]
+    if any(len(trials[i]) != sum(len(r["trials"][skill]) for r in runs[i]) for i in (0, 1)):
+        raise SystemExit("the evaluations of one side repeat trials (the same seed twice?)")
     if trials[0].keys() != trials[1].keys():
         raise SystemExit("the two evaluations did not run the same trials")
     a, b, c, d = paired_cells((trials[0][k], trials[1][k]) for k in trials[0])
     n = a + b + c + d
-    for r, k in zip(runs, (a + b, a + c)):
+    for side, k in zip(runs, (a + b, a + c)):
         lo, hi = wilson(k, n)
-        print(f"{r['label']:40s} {100 * k / n:5.1f}% [{100 * lo:.1f}-{100 * hi:.1f}] ({k} of {n})")
+        print(f"{side[0]['label']:40s} {100 * k / n:5.1f}% [{100 * lo:.1f}-{100 * hi:.1f}] ({k} of {n})")
     lo, hi = newcombe_paired(a, b, c, d)
     print(f"difference (first - second): {100 * (b - c) / n:+.1f} points [{100 * lo:+.1f}, {100 * hi:+.1f}]; "
           f"only the first: {b}, only the second: {c}; exact McNemar p = {mcnemar_exact(b, c):.3g}")
