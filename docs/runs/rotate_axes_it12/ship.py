@@ -57,7 +57,7 @@ new = dict(
     commands=[
         f"bash docs/runs/rotate_axes_it12/run.sh {AX}   # searches A (the opposite axis's gaits run backwards), B (the "
         f"axis's own) and 2 (a second round from the better), the candidate {candidate['log']} (selection "
-        f"{candidate['success']:.3f} of {candidate.get('selection_episodes')}), its clone and the held-out cells; "
+        f"success {100 * candidate['success']:.1f}% of its new training starts), its clone and the held-out cells; "
         f"logs {D}/search_{{A,B,2}}.log",
         open(f"{RUN}/command.txt").read().strip() + f"   # log {D}/clone_s0/log.jsonl",
         f"unicross eval --policy {RUN}/policy.pt {HELDOUT} --out {D}/clone_s0_test120",
