@@ -12,16 +12,23 @@ stage() {
   unicross distill --experts $E --out $R --epochs ${EPOCHS:-1500} $RES --set model.init_policy=runs/student_1204_morning.pt --set optim.lr=1.0e-4 --set optim.warmup_frames=102400 --set env.object_limit=null --set collector.rollout_steps=256 --set optim.grad_steps=30 --set optim.batch_size=1024 --set buffer.capacity=300000 --set logging.checkpoint_every=25 --set seed=$S --set env.chain_share=0.15 --set 'optim.mode_weights={rotate_x+: 30}' --set optim.l1=0.01 "$@" > $R.log 2>&1
 }
 
-# experts_dir: runs/experts1205x (the ten shipped experts, unicross/checkpoints/allegro/<mode>.pt, as
-# <mode>/checkpoint.pt) and runs/student_1204_morning.pt (the stage's default init), made when missing (a fresh
-# checkout); stage and experts_with_xp call it
+# experts_dir: runs/experts1205x (the ten experts shipped when screens A-L ran, unicross/checkpoints/allegro/<mode>.pt
+# of commit a60ae24^, before the z- and y+ experts were replaced, as <mode>/checkpoint.pt) and
+# runs/student_1204_morning.pt (the stage's default init), made when missing (a fresh checkout); stage and
+# experts_with_xp call it
 experts_dir() {
+  experts_at a60ae24^ runs/experts1205x || return 1
+  [ -f runs/student_1204_morning.pt ] || git show e10d371:unicross/checkpoints/allegro/student.pt > runs/student_1204_morning.pt
+}
+
+# experts_at COMMIT DIR: the ten experts shipped at COMMIT (unicross/checkpoints/allegro/<mode>.pt) as
+# DIR/<mode>/checkpoint.pt, each made when missing
+experts_at() {
   local m
   for m in $MODES; do
-    [ -f runs/experts1205x/$m/checkpoint.pt ] && continue
-    mkdir -p runs/experts1205x/$m && cp unicross/checkpoints/allegro/$m.pt runs/experts1205x/$m/checkpoint.pt || return 1
+    [ -f $2/$m/checkpoint.pt ] && continue
+    mkdir -p $2/$m && git show $1:unicross/checkpoints/allegro/$m.pt > $2/$m/checkpoint.pt || return 1
   done
-  [ -f runs/student_1204_morning.pt ] || git show e10d371:unicross/checkpoints/allegro/student.pt > runs/student_1204_morning.pt
 }
 
 # experts_with_xp DIR POLICY: the shipped experts (runs/experts1205x) with rotate_x+ replaced by POLICY

@@ -5,7 +5,8 @@ cells (and for K and L the long-horizon cells) over four evaluation seeds.
 
 SCREEN (default I) names the students: I, x+ weight 10 on training seeds 4, 5, 6 (tag _w10ship); J, x+ weight 5 on
 seeds 7, 8, 9 (tag _w5ship); K, J's recipe on seeds 10, 11, 12; L, K's with env.chain_repeats={rotate_x+: 1,
-translate_z-: 3} on seeds 13, 14, 15 (tag _chz). Rotate cells: the student's successes pooled over its three training seeds and evaluation
+translate_z-: 3} on seeds 13, 14, 15 (tag _chz); M, K's stage from K's initial student with the new z- and y+
+experts on seeds 16, 17, 18 (tag _m). Rotate cells: the student's successes pooled over its three training seeds and evaluation
 seeds 0-3 (n = 1200; seed 0 from student_cells_rep3TAG_sS.json, 1-3 from rotate_seeds_rep3TAG_sS.json) against the mode's shipped
 expert over evaluation seeds 0-3 (rotate_seeds_experts.json, n = 400) minus 5 points. Every other cell as judge3.py:
 the evaluation-seed-0 cells pooled over the three students against docs/results.md's expert cell - 5 (grasp,
@@ -13,7 +14,9 @@ relocate, translate) and the shipped student's long horizon - 5; for K each long
 cells (seeds 1-3 from chain_seeds_rep3TAG_sS.json) against the shipped student over evaluation seeds 0-3
 (chain_seeds_shipped.json, n = 400) minus 5 points; for L against K's seed 10, shipped since (its seed-0 cells and
 chain_seeds_rep3_w5ship_s10.json, n = 400) minus 5 points, and L passes only when its pooled Gr. + Re. + Trans. also
-has its 95% lower bound above that student's rate (L3: a gain). The last line is PASSED or FAILED (ship.py reads it).
+has its 95% lower bound above that student's rate (L3: a gain). M as L, with the z- and y+ experts' cells from
+rotate_seeds_experts_m.json; a missed z- or y+ bar is excused (M3b) when every other bar is met and that cell's pooled
+95% lower bound is above K's seed 10 over evaluation seeds 0-3 (a gain over the shipped student). The last line is PASSED or FAILED (ship.py reads it).
 """
 import importlib.util
 import json
@@ -25,7 +28,9 @@ from unicross.metrics import wilson_interval
 HERE = os.path.dirname(os.path.abspath(__file__))
 # the export's tag, the training seeds, whether the long horizon pools evaluation seeds 0-3
 SCREENS = {"I": ("_w10ship", (4, 5, 6), False), "J": ("_w5ship", (7, 8, 9), False), "K": ("_w5ship", (10, 11, 12), True),
-           "L": ("_chz", (13, 14, 15), True)}
+           "L": ("_chz", (13, 14, 15), True), "M": ("_m", (16, 17, 18), True)}
+NEW_EXPERTS = "rotate_seeds_experts_m.json"  # M1: the z- and y+ experts shipped since K
+L_REF_ROTATE = "rotate_seeds_rep3_w5ship_s10.json"  # M3b: the shipped student's rotate cells under seeds 1-3
 # L's long-horizon reference: K's seed 10 (shipped by K), its evaluation-seed-0 cells and seeds 1-3
 L_REF = ("student_cells_rep3_w5ship_s10.json", "chain_seeds_rep3_w5ship_s10.json")
 GAIN = "Gr. + Re. + Trans."  # L3: the chain that must gain
@@ -58,16 +63,20 @@ if __name__ == "__main__":
     cells_files = [os.path.join(HERE, f"student_cells_rep3{tag}_s{s}.json") for s in seeds]
     rot_files = [os.path.join(HERE, f"rotate_seeds_rep3{tag}_s{s}.json") for s in seeds]
     chain_files = [os.path.join(HERE, f"chain_seeds_rep3{tag}_s{s}.json") for s in seeds] if chain_seeds else []
-    refs = list(L_REF) if screen == "L" else ["chain_seeds_shipped.json"]
+    refs = list(L_REF) if screen in "LM" else ["chain_seeds_shipped.json"]
     chain_files += [os.path.join(HERE, f) for f in refs] if chain_seeds else []
-    missing = [f for f in cells_files + rot_files + chain_files if not os.path.exists(f)]
+    extra = [os.path.join(HERE, f) for f in (NEW_EXPERTS, L_REF_ROTATE)] if screen == "M" else []
+    missing = [f for f in cells_files + rot_files + chain_files + extra if not os.path.exists(f)]
     if missing:
         sys.exit("missing: " + ", ".join(missing))
     experts = json.load(open(os.path.join(HERE, "rotate_seeds_experts.json")))["cells"]
+    new_experts = json.load(open(os.path.join(HERE, NEW_EXPERTS)))["cells"] if screen == "M" else {}
+    experts.update(new_experts)
+    excusable = {}  # M3b: mode -> (pooled lower bound, the shipped student's rate over seeds 0-3)
     pool, cells = judge3.pooled(cells_files)
     rots = [json.load(open(f))["cells"] for f in rot_files]
     chains = [json.load(open(f)) for f in chain_files]
-    if screen == "L":  # the reference's seed-0 cells from its report cells, seeds 1-3 from its chain_seeds file
+    if screen in "LM":  # the reference's seed-0 cells from its report cells, seeds 1-3 from its chain_seeds file
         seed0, rest = chains.pop(-2), chains.pop()
         chains.append({c: {"0": seed0["long_horizon"]["summary"][c]["overall"], **rest["cells"][c]}
                        for c in rest["cells"]})
@@ -76,18 +85,25 @@ if __name__ == "__main__":
     shipped = json.load(open(os.path.join(HERE, "..", "translate_zm_reference", "thickness",
                                           "student_cells_seed0.json")))
     ok = True
+    missed = []  # M: missed z- or y+ bars, judged by M3b below
     print("| cell | " + " | ".join(f"seed {s}" for s in seeds) + " | student pooled [95% CI] | expert [95% CI] | bar | |")
     print("|---|---|---|---|---|---|---|---|")
     for name, (k, n) in pool.items():
         if name.startswith("rotate_"):
             ex = experts[name]
             measured = 100 * ex["0"]["successes"] / ex["0"]["n"]
-            if measured != judge3.EXPERT[name]:
+            if measured != judge3.EXPERT[name] and name not in new_experts:
                 print(f"note: {name}: the expert's seed-0 cell measured {measured:g}, "
                       f"docs/results.md {judge3.EXPERT[name]:g}")
             k, n, per, (ke, ne) = over_seeds(ex, [c["test"][name]["summary"] for c in cells], [r[name] for r in rots])
             expert = ci(ke, ne)
             bar = 100 * ke / ne - 5
+            if name in new_experts:
+                ref0 = json.load(open(os.path.join(HERE, L_REF[0])))["test"][name]["summary"]
+                ref = json.load(open(os.path.join(HERE, L_REF_ROTATE)))["cells"][name]
+                kr = ref0["successes"] + sum(ref[e]["successes"] for e in EVAL_SEEDS[1:])
+                nr = ref0["n"] + sum(ref[e]["n"] for e in EVAL_SEEDS[1:])
+                excusable[name] = (100 * wilson_interval(k, n)[0], 100 * kr / nr)
         elif name in judge3.EXPERT:
             per = [c["test"][name]["summary"]["sr"] for c in cells]
             expert = f"{judge3.EXPERT[name]:g} (n=100+, seed 0)"
@@ -110,7 +126,10 @@ if __name__ == "__main__":
             expert = f"shipped student {ref:g}"
             bar = ref - 5
         good = 100 * k / n >= bar - 1e-9
-        ok &= good
+        if not good and name in excusable:
+            missed.append(name)
+        else:
+            ok &= good
         print(f"| {name} | " + " | ".join(f"{p:.1f}" for p in per) + f" | {ci(k, n)} | {expert} | >= {bar:.2f} | "
               f"{'ok' if good else 'MISSED'} |")
     if gain is not None:
@@ -118,5 +137,13 @@ if __name__ == "__main__":
         print(f"L3 gain: {GAIN} pooled lower bound {lo:.2f} {'>' if lo > rate else '<='} the shipped student's "
               f"{rate:.2f}: {'ok' if lo > rate else 'MISSED'}")
         ok &= lo > rate
-    print(f"rule.txt {screen}3: {'PASSED' if ok else 'FAILED'}")
+    for name in missed:
+        lo, rate = excusable[name]
+        gained = lo > rate
+        print(f"M3b: {name} missed its bar (the issue's target); pooled lower bound {lo:.2f} "
+              f"{'>' if gained else '<='} the shipped student's {rate:.2f} over seeds 0-3: "
+              f"{'a gain' if gained else 'MISSED'}")
+        ok &= gained
+    print(f"rule.txt {screen}3: {'PASSED' if ok else 'FAILED'}"
+          + (f" (M3b: {', '.join(missed)} below the issue's target)" if ok and missed else ""))
     sys.exit(0 if ok else 1)
