@@ -22,6 +22,7 @@ if [ ! -f $D/student_cells_rep3_m_s$S.json ]; then
   stage runs/experts1207 runs/l1rep3m_s$S $S --set 'env.mode_repeats={rotate_x+: 3}' \
     --set "optim.mode_weights={rotate_x+: 5}" --set model.init_policy=runs/student_pre_k.pt || exit 1
   unicross export runs/l1rep3m_s$S --out $P || exit 1
+  cp runs/l1rep3m_s$S/metrics.jsonl $D/metrics_rep3_m_s$S.jsonl
   python docs/runs/student_ft_1202b/seed_cells.py $P $D/student_cells_rep3_m_s$S.json > runs/cells_l1rep3m_s$S.log 2>&1 \
     || exit 1
 fi
