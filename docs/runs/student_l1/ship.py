@@ -6,7 +6,8 @@ committed export, then rewrite the sidecar (the replaced record under ``replaced
 
 SCREEN is a key of ``SCREENS`` (G: x+ weight 10, seeds 1-3; H: x+ weight 15, seeds 1-3; I: G's recipe on seeds 4-6,
 rotate cells over evaluation seeds 0-3; J: I's judge, x+ weight 5, seeds 7-9; K: J's recipe on seeds 10-12, long-horizon cells over evaluation seeds 0-3 too; all x+ walked three times, l1 0.01, from the shipped student;
-L: K's with env.chain_repeats={rotate_x+: 1, translate_z-: 3} on seeds 13-15, from K's initial student, tag _chz). It refuses to
+L: K's with env.chain_repeats={rotate_x+: 1, translate_z-: 3} on seeds 13-15, from K's initial student, tag _chz; M: K's
+stage from K's initial student with the experts shipped at 723f266 (new z- and y+), seeds 16-18, tag _m). It refuses to
 write unless the screen's judge output (``judge_<screen>.txt``, e.g. judge_h.txt) ends in PASSED; ``--dry`` prints the new sidecar without writing anything. The stage command in the sidecar is
 common.sh's ``stage`` with ``ship_screen``'s arguments, as run_g.sh / run_h.sh call it.
 """
@@ -25,13 +26,23 @@ SCREENS = {"G": (10, (1, 2, 3), JUDGE3), "H": (15, (1, 2, 3), JUDGE3),
            "I": (10, (4, 5, 6), f"python {D}/judge_i.py   # also reads {D}/rotate_seeds_*.json"),
            "J": (5, (7, 8, 9), f"python {D}/judge_i.py J   # also reads {D}/rotate_seeds_*.json"),
            "K": (5, (10, 11, 12), f"python {D}/judge_i.py K   # also reads {D}/rotate_seeds_*.json, {D}/chain_seeds_*.json"),
-           "L": (5, (13, 14, 15), f"python {D}/judge_i.py L   # also reads {D}/rotate_seeds_*.json, {D}/chain_seeds_*.json")}
+           "L": (5, (13, 14, 15), f"python {D}/judge_i.py L   # also reads {D}/rotate_seeds_*.json, {D}/chain_seeds_*.json"),
+           "M": (5, (16, 17, 18), f"python {D}/judge_i.py M   # also reads {D}/rotate_seeds_*.json, {D}/chain_seeds_*.json")}
 # screens whose export tag and stage differ from ship_screen's (run_l.sh): the tag, the stage's last arguments and
 # the command that makes their initial student, which is the shipped student's own initial one (its ``replaced``)
 OTHER_STAGE = {"L": ("_chz", "--set model.init_policy=runs/student_pre_k.pt "
                              "--set 'env.chain_repeats={{rotate_x+: 1, translate_z-: 3}}'",
                      "git show 06e213f^:unicross/checkpoints/allegro/student.pt > runs/student_pre_k.pt   "
-                     "# K's initial student (run_l.sh)")}
+                     "# K's initial student (run_l.sh)"),
+               "M": ("_m", "--set model.init_policy=runs/student_pre_k.pt",
+                     "git show 06e213f^:unicross/checkpoints/allegro/student.pt > runs/student_pre_k.pt   "
+                     "# K's initial student (run_m.sh)")}
+# the teachers: the experts folder, the commit whose shipped experts fill it and their description
+TEACHERS = ("runs/experts1205x", "fe6c582", "the ten Allegro experts shipped at commit fe6c582 (rotate x+ = the clone "
+            "of the x+ finger sequence)")
+OTHER_TEACHERS = {"M": ("runs/experts1207", "723f266", "the ten Allegro experts shipped at commit 723f266 (rotate x+ = "
+                        "the clone of the x+ finger sequence; z- and y+ = the clones of gaits searched under 12 solver "
+                        "iterations, 63rd and 64th sessions)")}
 MODES = "grasp relocate rotate_x+ rotate_x- rotate_y+ rotate_y- rotate_z+ rotate_z- translate_z+ translate_z-"
 
 if __name__ == "__main__":
@@ -41,7 +52,8 @@ if __name__ == "__main__":
         sys.exit(f"usage: python {D}/ship.py SCREEN [--dry], SCREEN one of {', '.join(SCREENS)}")
     name = args[0]
     weight, (ship_seed, *others), judge_cmd = SCREENS[name]
-    tag, extra, init_cmd = OTHER_STAGE.get(name, (f"_w{weight}ship", "", None))
+    tag, extra, init_cmd = OTHER_STAGE.get(name, (f"_w{weight}ship", "--set model.init_policy=allegro/student", None))
+    experts, experts_commit, teachers = OTHER_TEACHERS.get(name, TEACHERS)
     run = f"runs/l1rep3{tag.strip('_')}_s{{s}}"
     export = f"{D}/student_l1_rep3{tag}_s{{s}}"
     cells_of = f"{D}/student_cells_rep3{tag}_s{{s}}.json"
@@ -59,19 +71,17 @@ if __name__ == "__main__":
     base = old["replaced"] if init_cmd else old  # the initial student's record: the lineage's commands and frames
     ck = torch.load(f"{export.format(s=ship_seed)}.pt", map_location="cpu", weights_only=False)
     wall_s = json.load(open(f"{export.format(s=ship_seed)}.json"))["train_wall_s"]  # the stage's, from the export's sidecar
-    stage = ("unicross distill --experts runs/experts1205x --out " + run + " --epochs 1500 "
+    stage = (f"unicross distill --experts {experts} --out " + run + " --epochs 1500 "
              "--set model.init_policy=runs/student_1204_morning.pt --set optim.lr=1.0e-4 "
              "--set optim.warmup_frames=102400 --set env.object_limit=null --set collector.rollout_steps=256 "
              "--set optim.grad_steps=30 --set optim.batch_size=1024 --set buffer.capacity=300000 "
              "--set logging.checkpoint_every=25 --set seed={s} --set env.chain_share=0.15 "
              "--set 'optim.mode_weights={{rotate_x+: 30}}' --set optim.l1=0.01 "
              "--set 'env.mode_repeats={{rotate_x+: 3}}' "
-             f"--set 'optim.mode_weights={{{{rotate_x+: {weight}}}}}' --set model.init_policy=allegro/student"
-             + (" " + extra if extra else ""))
+             f"--set 'optim.mode_weights={{{{rotate_x+: {weight}}}}}' " + extra)
     commands = base["commands"] + ([init_cmd] if init_cmd else []) + [
-        f"mkdir -p runs/experts1205x; for m in {MODES}; do mkdir -p runs/experts1205x/$m; "
-        "cp unicross/checkpoints/allegro/$m.pt runs/experts1205x/$m/checkpoint.pt; done   # the ten shipped experts "
-        f"of commit fe6c582 (rotate x+ = the clone of the x+ finger sequence); {D}/common.sh: experts_dir",
+        f"for m in {MODES}; do mkdir -p {experts}/$m; git show {experts_commit}:unicross/checkpoints/allegro/$m.pt "
+        f"> {experts}/$m/checkpoint.pt; done   # {teachers}; {D}/common.sh: experts_at",
         stage.format(s=ship_seed) + f"   # commit {ck['git_commit'][:7]}, {wall_s / 60:.0f} min on 2 cores ({D}/rule.txt "
         f"screen {name}; later --set values override earlier ones: init = "
         f"{'runs/student_pre_k.pt, the initial student of the one this replaces' if init_cmd else 'the student this replaces'}, "
@@ -106,10 +116,10 @@ if __name__ == "__main__":
                     f"replaced{'.replaced' if init_cmd else ''}) and this "
                     f"stage (stage_frames, stage_wall_s: rotate x+ walked three times with weight {weight}, l1 0.01, "
                     f"env.chain_share 0.15{' (chain_repeats: the stage command)' if extra else ''}, on the ten "
-                    "shipped experts)",
+                    f"experts of {experts_commit})",
         rule=f"{D}/rule.txt screen {name} (three seeds pooled, {judge_cmd.split()[1]}; seed {ship_seed} named "
              "before the runs)",
-        teachers="the ten Allegro experts shipped at commit fe6c582 (rotate x+ = the clone of the x+ finger sequence)",
+        teachers=teachers,
         test_cells=test_cells(cells), long_horizon_overall=overall(cells), other_seeds=seeds,
         long_horizon_note="the stage acts in long-horizon chains too (env.chain_share 0.15); per seed and pooled in "
                           f"{D}/README.md",
