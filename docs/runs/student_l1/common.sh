@@ -27,7 +27,8 @@ experts_at() {
   local m
   for m in $MODES; do
     [ -f $2/$m/checkpoint.pt ] && continue
-    mkdir -p $2/$m && git show $1:unicross/checkpoints/allegro/$m.pt > $2/$m/checkpoint.pt || return 1
+    mkdir -p $2/$m && git show $1:unicross/checkpoints/allegro/$m.pt > $2/$m/checkpoint.tmp \
+      && mv $2/$m/checkpoint.tmp $2/$m/checkpoint.pt || return 1
   done
 }
 
