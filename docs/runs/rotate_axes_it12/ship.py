@@ -22,7 +22,6 @@ CK = f"unicross/checkpoints/allegro/rotate_{AX}"
 HELDOUT = f"--protocol rotate --axis {AX} --objects test --limit 20 --trials-per-object 3 --seed 0 --workers 2"
 
 
-
 def lower_end(path):
     """The lower end of the paired difference's 95% interval in a paired.py output."""
     return float(re.search(r"\[([+-]?[\d.]+),", open(path).read().split("difference", 1)[-1]).group(1))

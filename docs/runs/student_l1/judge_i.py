@@ -63,7 +63,7 @@ if __name__ == "__main__":
     cells_files = [os.path.join(HERE, f"student_cells_rep3{tag}_s{s}.json") for s in seeds]
     rot_files = [os.path.join(HERE, f"rotate_seeds_rep3{tag}_s{s}.json") for s in seeds]
     chain_files = [os.path.join(HERE, f"chain_seeds_rep3{tag}_s{s}.json") for s in seeds] if chain_seeds else []
-    refs = list(L_REF) if screen in "LM" else ["chain_seeds_shipped.json"]
+    refs = list(L_REF) if screen in ("L", "M") else ["chain_seeds_shipped.json"]
     chain_files += [os.path.join(HERE, f) for f in refs] if chain_seeds else []
     extra = [os.path.join(HERE, f) for f in (NEW_EXPERTS, L_REF_ROTATE)] if screen == "M" else []
     missing = [f for f in cells_files + rot_files + chain_files + extra if not os.path.exists(f)]
@@ -76,7 +76,7 @@ if __name__ == "__main__":
     pool, cells = judge3.pooled(cells_files)
     rots = [json.load(open(f))["cells"] for f in rot_files]
     chains = [json.load(open(f)) for f in chain_files]
-    if screen in "LM":  # the reference's seed-0 cells from its report cells, seeds 1-3 from its chain_seeds file
+    if screen in ("L", "M"):  # the reference's seed-0 cells from its report cells, seeds 1-3 from its chain_seeds file
         seed0, rest = chains.pop(-2), chains.pop()
         chains.append({c: {"0": seed0["long_horizon"]["summary"][c]["overall"], **rest["cells"][c]}
                        for c in rest["cells"]})
@@ -101,8 +101,7 @@ if __name__ == "__main__":
             if name in new_experts:
                 ref0 = json.load(open(os.path.join(HERE, L_REF[0])))["test"][name]["summary"]
                 ref = json.load(open(os.path.join(HERE, L_REF_ROTATE)))["cells"][name]
-                kr = ref0["successes"] + sum(ref[e]["successes"] for e in EVAL_SEEDS[1:])
-                nr = ref0["n"] + sum(ref[e]["n"] for e in EVAL_SEEDS[1:])
+                kr, nr, _, _ = over_seeds(ex, [ref0], [ref])  # the shipped student as one student over seeds 0-3
                 excusable[name] = (100 * wilson_interval(k, n)[0], 100 * kr / nr)
         elif name in judge3.EXPERT:
             per = [c["test"][name]["summary"]["sr"] for c in cells]
