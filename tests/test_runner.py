@@ -73,6 +73,20 @@ def test_resume_needs_a_checkpoint(tmp_path):
         Counter(tmp_path / "none", resume=True)
 
 
+def test_a_resumed_run_may_name_another_mode_in_a_mode_map(tmp_path):
+    """``{mode: w}`` fields are empty in configs/dagger.yaml: a run started with one mode named in them
+    may be resumed naming another (merged), while a typo elsewhere still fails."""
+    run = Counter(tmp_path / "r", overrides=dict(optim=dict(mode_weights={"rotate_x+": 5.0})))
+    run.step()
+    run.save()
+    run.release()
+    with pytest.raises(KeyError, match="unknown config key 'optim.lrr'"):
+        Counter(tmp_path / "r", resume=True, overrides=dict(optim=dict(lrr=1.0)))
+    again = Counter(tmp_path / "r", resume=True, overrides=dict(optim=dict(mode_weights={"grasp": 3.0})))
+    assert again.cfg["optim"]["mode_weights"] == {"rotate_x+": 5.0, "grasp": 3.0}
+    again.release()
+
+
 def test_a_resumed_csv_keeps_its_columns_when_the_fields_grow(tmp_path):
     """A run resumed under a version with a new reward term: metrics.csv keeps its header, every row
     lines up with it (the new column goes to metrics.jsonl only)."""

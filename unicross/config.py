@@ -18,9 +18,13 @@ if not CONFIG_DIR.exists():  # installed (non-editable): configs ship as unicros
 FREE_FORM = ("task_config", "reward_config")
 
 
-def deep_merge(base: dict, override: Optional[Mapping[str, Any]], path: str = "", strict: bool = True) -> dict:
+def deep_merge(base: dict, override: Optional[Mapping[str, Any]], path: str = "", strict: bool = True,
+               defaults: Optional[Mapping[str, Any]] = None) -> dict:
     """Return ``base`` updated by ``override``; unknown keys are an error (typos fail loudly),
-    except inside the free-form sections (``FREE_FORM``, or an empty mapping in ``base``)."""
+    except inside the free-form sections (``FREE_FORM``, or an empty mapping in ``base``).
+    ``defaults``: the config file's own values when ``base`` is a saved config (a checkpoint's): a
+    mapping empty there (``{mode: w}`` fields such as ``optim.mode_weights``) stays free-form whatever
+    the saved config holds in it, so a resumed run may name another mode."""
     out = copy.deepcopy(base)
     for k, v in (override or {}).items():
         if k not in out:
@@ -28,10 +32,12 @@ def deep_merge(base: dict, override: Optional[Mapping[str, Any]], path: str = ""
                 raise KeyError(f"unknown config key {path + k!r}; valid: {sorted(out)}")
             out[k] = copy.deepcopy(v)
             continue
-        if isinstance(out[k], dict) and isinstance(v, Mapping) and (k in FREE_FORM or not out[k]):
+        d = defaults.get(k) if isinstance(defaults, Mapping) else None
+        free = k in FREE_FORM or not out[k] or (isinstance(d, Mapping) and not d)
+        if isinstance(out[k], dict) and isinstance(v, Mapping) and free:
             out[k] = deep_merge(out[k], v, path + k + ".", strict=False)
         elif isinstance(out[k], dict) and isinstance(v, Mapping):
-            out[k] = deep_merge(out[k], v, path + k + ".", strict=strict)
+            out[k] = deep_merge(out[k], v, path + k + ".", strict=strict, defaults=d)
         else:
             out[k] = _checked(path + k, out[k], copy.deepcopy(v))
     return out

@@ -137,7 +137,7 @@ def open_run(run_dir: Path, resume: bool, overrides: Optional[dict], config_name
                              f"`unicross {kind} --resume --out {run_dir}`")
         from unicross.rl.policy_io import check_modes
         check_modes(ckpt, ckpt_path)
-        cfg = deep_merge(ckpt["config"], overrides)
+        cfg = deep_merge(ckpt["config"], overrides, defaults=load_config(config_name))
         validate_ranges(config_name, cfg)
     else:
         if ckpt_path.exists():
