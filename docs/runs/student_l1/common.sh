@@ -75,3 +75,23 @@ ship_screen() {
   rep_screen runs/l1rep3w$1ship_s$2 _w$1ship $2 --set "optim.mode_weights={rotate_x+: $1}" \
     --set model.init_policy=allegro/student
 }
+
+# seed_evals TAG SEED: the rotate cells (rotate_seeds.py) and the long horizon (chain_seeds.py) of
+# $D/student_l1_rep3TAG_sSEED.pt under evaluation seeds 1-3 (screens L, M, N), each skipped when its file exists
+seed_evals() {
+  local P=$D/student_l1_rep3$1_s$2.pt N=l1rep3${1#_}_s$2
+  [ -f $D/rotate_seeds_rep3$1_s$2.json ] \
+    || python $D/rotate_seeds.py $D/rotate_seeds_rep3$1_s$2.json $P > runs/rotseeds_$N.log 2>&1 || return 1
+  [ -f $D/chain_seeds_rep3$1_s$2.json ] \
+    || python $D/chain_seeds.py $D/chain_seeds_rep3$1_s$2.json $P > runs/chainseeds_$N.log 2>&1 || return 1
+}
+
+# m_stage SEED: screen M's stage (K's arguments from K's initial student, the experts shipped at 723f266) into
+# runs/l1rep3m_sSEED, resumed when it has a checkpoint (run_m.sh; run_n.sh when M's run is missing)
+m_stage() {
+  experts_at 723f266 runs/experts1207 || return 1
+  [ -f runs/student_pre_k.pt ] || git show 06e213f^:unicross/checkpoints/allegro/student.pt > runs/student_pre_k.pt \
+    || return 1
+  stage runs/experts1207 runs/l1rep3m_s$1 $1 --set 'env.mode_repeats={rotate_x+: 3}' \
+    --set "optim.mode_weights={rotate_x+: 5}" --set model.init_policy=runs/student_pre_k.pt
+}

@@ -12,10 +12,5 @@ S=$1
 [ -f runs/student_pre_k.pt ] || git show 06e213f^:unicross/checkpoints/allegro/student.pt > runs/student_pre_k.pt || exit 1
 rep_screen runs/l1rep3chz_s$S _chz $S --set "optim.mode_weights={rotate_x+: 5}" \
   --set model.init_policy=runs/student_pre_k.pt --set 'env.chain_repeats={rotate_x+: 1, translate_z-: 3}' || exit 1
-[ -f $D/rotate_seeds_rep3_chz_s$S.json ] \
-  || python $D/rotate_seeds.py $D/rotate_seeds_rep3_chz_s$S.json $D/student_l1_rep3_chz_s$S.pt \
-       > runs/rotseeds_l1rep3chz_s$S.log 2>&1 || exit 1
-[ -f $D/chain_seeds_rep3_chz_s$S.json ] \
-  || python $D/chain_seeds.py $D/chain_seeds_rep3_chz_s$S.json $D/student_l1_rep3_chz_s$S.pt \
-       > runs/chainseeds_l1rep3chz_s$S.log 2>&1 || exit 1
+seed_evals _chz $S || exit 1
 echo DONE

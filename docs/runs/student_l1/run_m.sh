@@ -16,18 +16,12 @@ if [ "$S" = experts ]; then
   echo DONE; exit 0
 fi
 P=$D/student_l1_rep3_m_s$S.pt
-experts_at 723f266 runs/experts1207 || exit 1
-[ -f runs/student_pre_k.pt ] || git show 06e213f^:unicross/checkpoints/allegro/student.pt > runs/student_pre_k.pt || exit 1
 if [ ! -f $D/student_cells_rep3_m_s$S.json ]; then
-  stage runs/experts1207 runs/l1rep3m_s$S $S --set 'env.mode_repeats={rotate_x+: 3}' \
-    --set "optim.mode_weights={rotate_x+: 5}" --set model.init_policy=runs/student_pre_k.pt || exit 1
+  m_stage $S || exit 1
   unicross export runs/l1rep3m_s$S --out $P || exit 1
   cp runs/l1rep3m_s$S/metrics.jsonl $D/metrics_rep3_m_s$S.jsonl
   python docs/runs/student_ft_1202b/seed_cells.py $P $D/student_cells_rep3_m_s$S.json > runs/cells_l1rep3m_s$S.log 2>&1 \
     || exit 1
 fi
-[ -f $D/rotate_seeds_rep3_m_s$S.json ] \
-  || python $D/rotate_seeds.py $D/rotate_seeds_rep3_m_s$S.json $P > runs/rotseeds_l1rep3m_s$S.log 2>&1 || exit 1
-[ -f $D/chain_seeds_rep3_m_s$S.json ] \
-  || python $D/chain_seeds.py $D/chain_seeds_rep3_m_s$S.json $P > runs/chainseeds_l1rep3m_s$S.log 2>&1 || exit 1
+seed_evals _m $S || exit 1
 echo DONE

@@ -1,6 +1,6 @@
 #!/bin/bash
 # rule.txt screen N: `run_n.sh SEED` copies screen M's run on that training seed (runs/l1rep3m_sSEED, epoch 1500,
-# its replay buffer; run_m.sh SEED makes it when missing) to runs/l1rep3n_sSEED and resumes it to epoch 2000 at
+# its replay buffer; common.sh m_stage makes it again when missing) to runs/l1rep3n_sSEED and resumes it to epoch 2000 at
 # optim.lr 3e-5, then the export (tag _n), the report's cells, the rotate cells and the long horizon under evaluation
 # seeds 1-3. Judged by judge_i.py N (N3). Each step is skipped when its file exists, so a call resumes.
 #   nohup bash -c 'for s in 16 17 18; do bash docs/runs/student_l1/run_n.sh $s || exit 1; done' > runs/student_l1_n.log 2>&1 &
@@ -13,7 +13,7 @@ P=$D/student_l1_rep3_n_s$S.pt
 R=runs/l1rep3n_s$S
 if [ ! -f $D/student_cells_rep3_n_s$S.json ]; then
   if [ ! -d $R ]; then
-    [ -f runs/l1rep3m_s$S/checkpoint.pt ] || bash $D/run_m.sh $S || exit 1
+    [ -f runs/l1rep3m_s$S/checkpoint.pt ] || m_stage $S || exit 1  # a fresh checkout: M's run made again
     cp -r runs/l1rep3m_s$S $R.tmp && mv $R.tmp $R || exit 1
   fi
   unicross distill --resume --out $R --epochs 2000 --set optim.lr=3.0e-5 > $R.log 2>&1 || exit 1
@@ -22,8 +22,5 @@ if [ ! -f $D/student_cells_rep3_n_s$S.json ]; then
   python docs/runs/student_ft_1202b/seed_cells.py $P $D/student_cells_rep3_n_s$S.json > runs/cells_l1rep3n_s$S.log 2>&1 \
     || exit 1
 fi
-[ -f $D/rotate_seeds_rep3_n_s$S.json ] \
-  || python $D/rotate_seeds.py $D/rotate_seeds_rep3_n_s$S.json $P > runs/rotseeds_l1rep3n_s$S.log 2>&1 || exit 1
-[ -f $D/chain_seeds_rep3_n_s$S.json ] \
-  || python $D/chain_seeds.py $D/chain_seeds_rep3_n_s$S.json $P > runs/chainseeds_l1rep3n_s$S.log 2>&1 || exit 1
+seed_evals _n $S || exit 1
 echo DONE
