@@ -34,11 +34,11 @@ EXPERTS = "experts:allegro"
 
 
 def record(object_set):
-    """The experts' translate chains: per step (observation tensors, expert action, mode, trial index)."""
+    """The experts' translate chains: per step (observation tensors, expert action, mode), and the trial count."""
     experts, _ = resolve_policy(EXPERTS, "allegro")
     objects = get_object_set(object_set, limit=10)
     rng = torch.Generator().manual_seed(0)
-    hand, obj, goal, act, mode, trial = [], [], [], [], [], []
+    hand, obj, goal, act, mode = [], [], [], [], []
     n = 0
     for oi, o in enumerate(objects):
         for k in range(5):
@@ -60,7 +60,6 @@ def record(object_set):
                 goal.append(ex["goal"].clone())
                 act.append(a.clone())
                 mode.append(u.mode.clone())
-                trial.append(torch.tensor([n]))
                 obs, _, term, _, _ = u.step(a)
                 if bool(term.all()):
                     break
@@ -68,7 +67,7 @@ def record(object_set):
             n += 1
             print(f"trial {n}: {o.name} translate {axis}", file=sys.stderr, flush=True)
     cat = lambda xs: torch.cat(xs, 0)  # noqa: E731
-    return dict(hand=cat(hand), obj=cat(obj), goal=cat(goal), act=cat(act), mode=cat(mode), trial=cat(trial), n=n)
+    return dict(hand=cat(hand), obj=cat(obj), goal=cat(goal), act=cat(act), mode=cat(mode), n=n)
 
 
 if __name__ == "__main__":
