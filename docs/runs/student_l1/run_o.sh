@@ -1,0 +1,26 @@
+#!/bin/bash
+# rule.txt screen O: `run_o.sh SEED` copies screen M's run on that training seed (runs/l1rep3m_sSEED, epoch 1500,
+# its replay buffer; common.sh m_stage makes it again when missing) to runs/l1rep3o_sSEED and resumes it to epoch 2000 at
+# the stage's optim.lr 1e-4 with the grasp rows weighted 3 (pilot B of docs/runs/chain_fit), then the export (tag _o), the
+# report's cells, the rotate cells and the long horizon under evaluation seeds 1-3. Judged by judge_i.py O (O3). Each step is skipped when its file exists, so a call resumes.
+#   nohup bash -c 'for s in 16 17 18; do bash docs/runs/student_l1/run_o.sh $s || exit 1; done' > runs/student_l1_o.log 2>&1 &
+set -x
+cd "$(dirname "$0")/../../.."
+source .venv/bin/activate
+source docs/runs/student_l1/common.sh
+S=$1
+P=$D/student_l1_rep3_o_s$S.pt
+R=runs/l1rep3o_s$S
+if [ ! -f $D/student_cells_rep3_o_s$S.json ]; then
+  if [ ! -d $R ]; then
+    [ -f runs/l1rep3m_s$S/checkpoint.pt ] || m_stage $S || exit 1  # a fresh checkout: M's run made again
+    cp -r runs/l1rep3m_s$S $R.tmp && mv $R.tmp $R || exit 1
+  fi
+  unicross distill --resume --out $R --epochs 2000 --set 'optim.mode_weights={rotate_x+: 5, grasp: 3}' > $R.log 2>&1 || exit 1
+  unicross export $R --out $P || exit 1
+  cp $R/metrics.jsonl $D/metrics_rep3_o_s$S.jsonl
+  python docs/runs/student_ft_1202b/seed_cells.py $P $D/student_cells_rep3_o_s$S.json > runs/cells_l1rep3o_s$S.log 2>&1 \
+    || exit 1
+fi
+seed_evals _o $S || exit 1
+echo DONE
