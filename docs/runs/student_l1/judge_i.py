@@ -17,7 +17,8 @@ chain_seeds_rep3_w5ship_s10.json, n = 400) minus 5 points, and L passes only whe
 has its 95% lower bound above that student's rate (L3: a gain). M as L, with the z- and y+ experts' cells from
 rotate_seeds_experts_m.json; a missed z- or y+ bar is excused (M3b) when every other bar is met and that cell's pooled
 95% lower bound is above K's seed 10 over evaluation seeds 0-3 (a gain over the shipped student). N as M: M's three
-runs resumed to epoch 2000 at lr 3e-5 (tag _n). The last line is PASSED or FAILED (ship.py reads it).
+runs resumed to epoch 2000 at lr 3e-5 (tag _n); O as M: M's three runs resumed to epoch 2000 with the grasp rows
+weighted 3 (tag _o). The last line is PASSED or FAILED (ship.py reads it).
 """
 import importlib.util
 import json
@@ -29,7 +30,9 @@ from unicross.metrics import wilson_interval
 HERE = os.path.dirname(os.path.abspath(__file__))
 # the export's tag, the training seeds, whether the long horizon pools evaluation seeds 0-3
 SCREENS = {"I": ("_w10ship", (4, 5, 6), False), "J": ("_w5ship", (7, 8, 9), False), "K": ("_w5ship", (10, 11, 12), True),
-           "L": ("_chz", (13, 14, 15), True), "M": ("_m", (16, 17, 18), True), "N": ("_n", (16, 17, 18), True)}
+           "L": ("_chz", (13, 14, 15), True), "M": ("_m", (16, 17, 18), True), "N": ("_n", (16, 17, 18), True),
+           "O": ("_o", (16, 17, 18), True)}
+M_LIKE = ("M", "N", "O")  # the screens judged with M's references (M1, M3b)
 NEW_EXPERTS = "rotate_seeds_experts_m.json"  # M1: the z- and y+ experts shipped since K
 L_REF_ROTATE = "rotate_seeds_rep3_w5ship_s10.json"  # M3b: the shipped student's rotate cells under seeds 1-3
 # L's long-horizon reference: K's seed 10 (shipped by K), its evaluation-seed-0 cells and seeds 1-3
@@ -64,20 +67,20 @@ if __name__ == "__main__":
     cells_files = [os.path.join(HERE, f"student_cells_rep3{tag}_s{s}.json") for s in seeds]
     rot_files = [os.path.join(HERE, f"rotate_seeds_rep3{tag}_s{s}.json") for s in seeds]
     chain_files = [os.path.join(HERE, f"chain_seeds_rep3{tag}_s{s}.json") for s in seeds] if chain_seeds else []
-    refs = list(L_REF) if screen in ("L", "M", "N") else ["chain_seeds_shipped.json"]
+    refs = list(L_REF) if screen in ("L", *M_LIKE) else ["chain_seeds_shipped.json"]
     chain_files += [os.path.join(HERE, f) for f in refs] if chain_seeds else []
-    extra = [os.path.join(HERE, f) for f in (NEW_EXPERTS, L_REF_ROTATE)] if screen in ("M", "N") else []
+    extra = [os.path.join(HERE, f) for f in (NEW_EXPERTS, L_REF_ROTATE)] if screen in M_LIKE else []
     missing = [f for f in cells_files + rot_files + chain_files + extra if not os.path.exists(f)]
     if missing:
         sys.exit("missing: " + ", ".join(missing))
     experts = json.load(open(os.path.join(HERE, "rotate_seeds_experts.json")))["cells"]
-    new_experts = json.load(open(os.path.join(HERE, NEW_EXPERTS)))["cells"] if screen in ("M", "N") else {}
+    new_experts = json.load(open(os.path.join(HERE, NEW_EXPERTS)))["cells"] if screen in M_LIKE else {}
     experts.update(new_experts)
     excusable = {}  # M3b: mode -> (pooled lower bound, the shipped student's rate over seeds 0-3)
     pool, cells = judge3.pooled(cells_files)
     rots = [json.load(open(f))["cells"] for f in rot_files]
     chains = [json.load(open(f)) for f in chain_files]
-    if screen in ("L", "M", "N"):  # the reference's seed-0 cells from its report cells, seeds 1-3 from its chain_seeds file
+    if screen in ("L", *M_LIKE):  # the reference's seed-0 cells from its report cells, seeds 1-3 from its chain_seeds file
         seed0, rest = chains.pop(-2), chains.pop()
         chains.append({c: {"0": seed0["long_horizon"]["summary"][c]["overall"], **rest["cells"][c]}
                        for c in rest["cells"]})

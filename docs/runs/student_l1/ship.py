@@ -7,7 +7,8 @@ committed export, then rewrite the sidecar (the replaced record under ``replaced
 SCREEN is a key of ``SCREENS`` (G: x+ weight 10, seeds 1-3; H: x+ weight 15, seeds 1-3; I: G's recipe on seeds 4-6,
 rotate cells over evaluation seeds 0-3; J: I's judge, x+ weight 5, seeds 7-9; K: J's recipe on seeds 10-12, long-horizon cells over evaluation seeds 0-3 too; all x+ walked three times, l1 0.01, from the shipped student;
 L: K's with env.chain_repeats={rotate_x+: 1, translate_z-: 3} on seeds 13-15, from K's initial student, tag _chz; M: K's
-stage from K's initial student with the experts shipped at 723f266 (new z- and y+), seeds 16-18, tag _m). It refuses to
+stage from K's initial student with the experts shipped at 723f266 (new z- and y+), seeds 16-18, tag _m; O: M's runs
+resumed to epoch 2000 with the grasp rows weighted 3, tag _o: ``RESUMED``). It refuses to
 write unless the screen's judge output (``judge_<screen>.txt``, e.g. judge_h.txt) ends in PASSED; ``--dry`` prints the new sidecar without writing anything. The stage command in the sidecar is
 common.sh's ``stage`` with ``ship_screen``'s arguments, as run_g.sh / run_h.sh call it.
 """
@@ -27,7 +28,11 @@ SCREENS = {"G": (10, (1, 2, 3), JUDGE3), "H": (15, (1, 2, 3), JUDGE3),
            "J": (5, (7, 8, 9), f"python {D}/judge_i.py J   # also reads {D}/rotate_seeds_*.json"),
            "K": (5, (10, 11, 12), f"python {D}/judge_i.py K   # also reads {D}/rotate_seeds_*.json, {D}/chain_seeds_*.json"),
            "L": (5, (13, 14, 15), f"python {D}/judge_i.py L   # also reads {D}/rotate_seeds_*.json, {D}/chain_seeds_*.json"),
-           "M": (5, (16, 17, 18), f"python {D}/judge_i.py M   # also reads {D}/rotate_seeds_*.json, {D}/chain_seeds_*.json")}
+           "M": (5, (16, 17, 18), f"python {D}/judge_i.py M   # also reads {D}/rotate_seeds_*.json, {D}/chain_seeds_*.json"),
+           "O": (5, (16, 17, 18), f"python {D}/judge_i.py O   # also reads {D}/rotate_seeds_*.json, {D}/chain_seeds_*.json")}
+# screens that resume another screen's runs (run_o.sh): the screen whose stage they resume, their tag, the epochs they
+# run to and the resume's arguments
+RESUMED = {"O": ("M", "_o", 2000, "--set 'optim.mode_weights={rotate_x+: 5, grasp: 3}'")}
 # screens whose export tag and stage differ from ship_screen's (run_l.sh): the tag, the stage's last arguments and
 # the command that makes their initial student, which is the shipped student's own initial one (its ``replaced``)
 OTHER_STAGE = {"L": ("_chz", "--set model.init_policy=runs/student_pre_k.pt "
@@ -52,8 +57,12 @@ if __name__ == "__main__":
         sys.exit(f"usage: python {D}/ship.py SCREEN [--dry], SCREEN one of {', '.join(SCREENS)}")
     name = args[0]
     weight, (ship_seed, *others), judge_cmd = SCREENS[name]
-    tag, extra, init_cmd = OTHER_STAGE.get(name, (f"_w{weight}ship", "--set model.init_policy=allegro/student", None))
-    experts, experts_commit, teachers = OTHER_TEACHERS.get(name, TEACHERS)
+    staged, tag, epochs, resume_args = RESUMED.get(name, (name, None, None, None))
+    stage_tag, extra, init_cmd = OTHER_STAGE.get(staged, (f"_w{weight}ship", "--set model.init_policy=allegro/student",
+                                                          None))
+    tag = tag or stage_tag
+    experts, experts_commit, teachers = OTHER_TEACHERS.get(staged, TEACHERS)
+    stage_run = f"runs/l1rep3{stage_tag.strip('_')}_s{{s}}"
     run = f"runs/l1rep3{tag.strip('_')}_s{{s}}"
     export = f"{D}/student_l1_rep3{tag}_s{{s}}"
     cells_of = f"{D}/student_cells_rep3{tag}_s{{s}}.json"
@@ -71,7 +80,10 @@ if __name__ == "__main__":
     base = old["replaced"] if init_cmd else old  # the initial student's record: the lineage's commands and frames
     ck = torch.load(f"{export.format(s=ship_seed)}.pt", map_location="cpu", weights_only=False)
     wall_s = json.load(open(f"{export.format(s=ship_seed)}.json"))["train_wall_s"]  # the stage's, from the export's sidecar
-    stage = (f"unicross distill --experts {experts} --out " + run + " --epochs 1500 "
+    # the commit and minutes of the stage's first run (a resumed screen: the resumed export's record)
+    first = json.load(open(f"{D}/student_l1_rep3{stage_tag}_s{ship_seed}.json")) if resume_args else dict(
+        git_commit=ck["git_commit"], train_wall_s=wall_s)
+    stage = (f"unicross distill --experts {experts} --out " + stage_run + " --epochs 1500 "
              "--set model.init_policy=runs/student_1204_morning.pt --set optim.lr=1.0e-4 "
              "--set optim.warmup_frames=102400 --set env.object_limit=null --set collector.rollout_steps=256 "
              "--set optim.grad_steps=30 --set optim.batch_size=1024 --set buffer.capacity=300000 "
@@ -79,13 +91,19 @@ if __name__ == "__main__":
              "--set 'optim.mode_weights={{rotate_x+: 30}}' --set optim.l1=0.01 "
              "--set 'env.mode_repeats={{rotate_x+: 3}}' "
              f"--set 'optim.mode_weights={{{{rotate_x+: {weight}}}}}' " + extra)
+    resume = (f"unicross distill --resume --out {run} --epochs {epochs} "  # a template of {s}, as stage
+              + resume_args.replace("{", "{{").replace("}", "}}")) if resume_args else None
     commands = base["commands"] + ([init_cmd] if init_cmd else []) + [
         f"for m in {MODES}; do mkdir -p {experts}/$m; git show {experts_commit}:unicross/checkpoints/allegro/$m.pt "
         f"> {experts}/$m/checkpoint.pt; done   # {teachers}; {D}/common.sh: experts_at",
-        stage.format(s=ship_seed) + f"   # commit {ck['git_commit'][:7]}, {wall_s / 60:.0f} min on 2 cores ({D}/rule.txt "
+        stage.format(s=ship_seed) + f"   # commit {first['git_commit'][:7]}, {first['train_wall_s'] / 60:.0f} min on 2 cores ({D}/rule.txt "
         f"screen {name}; later --set values override earlier ones: init = "
         f"{'runs/student_pre_k.pt, the initial student of the one this replaces' if init_cmd else 'the student this replaces'}, "
         f"x+ weight {weight})",
+        *([f"cp -r {stage_run.format(s=ship_seed)} {run.format(s=ship_seed)}   # {D}/run_{name.lower()}.sh",
+           resume.format(s=ship_seed) + f"   # commit {ck['git_commit'][:7]}, {(wall_s - first['train_wall_s']) / 60:.0f} "
+           f"min on 2 cores (rule.txt screen {name}: the stage resumed with its replay buffer)"]
+          if resume_args else []),
         f"unicross export {run.format(s=ship_seed)} --out {export.format(s=ship_seed)}.pt",
         f"python docs/runs/student_ft_1202b/seed_cells.py {export.format(s=ship_seed)}.pt "
         f"{cells_of.format(s=ship_seed)}   # the report's test cells and long horizon, 7 min",
@@ -104,18 +122,19 @@ if __name__ == "__main__":
     seeds = []
     for s in others:
         c = json.load(open(cells_of.format(s=s)))
-        seeds.append(dict(seed=s, command=stage.format(s=s) + f" (export {export.format(s=s)}.pt); judged pooled "
+        seeds.append(dict(seed=s, command=stage.format(s=s) + (f"; {resume.format(s=s)}" if resume else "") + f" (export {export.format(s=s)}.pt); judged pooled "
                           f"with seed {ship_seed}, not chosen on", test_cells=test_cells(c), long_horizon_overall=overall(c)))
     new = dict(
         skill=ck["skill"], axis=ck["axis"], hand=ck["hand"], epoch=ck["epoch"], frames=base["frames"] + ck["frames"],
         distilled_modes=ck["distilled_modes"], git_commit=ck["git_commit"],
-        commits=base["commits"] + [ck["git_commit"]], commands=commands, hardware=base["hardware"],
+        commits=base["commits"] + [first["git_commit"]] * bool(resume_args) + [ck["git_commit"]], commands=commands, hardware=base["hardware"],
         train_wall_s=round(base["train_wall_s"] + wall_s, 1), stage_frames=ck["frames"], stage_wall_s=round(wall_s, 1),
         frames_note="frames and train_wall_s count every stage from the first DAgger run: the student this stage "
                     f"started from ({base['frames']} frames, {base['train_wall_s']} s; its own frames_note under "
                     f"replaced{'.replaced' if init_cmd else ''}) and this "
                     f"stage (stage_frames, stage_wall_s: rotate x+ walked three times with weight {weight}, l1 0.01, "
-                    f"env.chain_share 0.15{' (chain_repeats: the stage command)' if extra else ''}, on the ten "
+                    f"{f'resumed to epoch {epochs} with {resume_args}, ' if resume_args else ''}"
+                    f"env.chain_share 0.15{' (chain_repeats: the stage command)' if 'chain_repeats' in extra else ''}, on the ten "
                     f"experts of {experts_commit})",
         rule=f"{D}/rule.txt screen {name} (three seeds pooled, {judge_cmd.split()[1]}; seed {ship_seed} named "
              "before the runs)",
