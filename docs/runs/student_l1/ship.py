@@ -97,7 +97,7 @@ if __name__ == "__main__":
         f"for m in {MODES}; do mkdir -p {experts}/$m; git show {experts_commit}:unicross/checkpoints/allegro/$m.pt "
         f"> {experts}/$m/checkpoint.pt; done   # {teachers}; {D}/common.sh: experts_at",
         stage.format(s=ship_seed) + f"   # commit {first['git_commit'][:7]}, {first['train_wall_s'] / 60:.0f} min on 2 cores ({D}/rule.txt "
-        f"screen {name}; later --set values override earlier ones: init = "
+        f"screen {staged}; later --set values override earlier ones: init = "
         f"{'runs/student_pre_k.pt, the initial student of the one this replaces' if init_cmd else 'the student this replaces'}, "
         f"x+ weight {weight})",
         *([f"cp -r {stage_run.format(s=ship_seed)} {run.format(s=ship_seed)}   # {D}/run_{name.lower()}.sh",
