@@ -95,3 +95,26 @@ m_stage() {
   stage runs/experts1207 runs/l1rep3m_s$1 $1 --set 'env.mode_repeats={rotate_x+: 3}' \
     --set "optim.mode_weights={rotate_x+: 5}" --set model.init_policy=runs/student_pre_k.pt
 }
+
+# resume_m TAG SEED [distill arguments]: screens N and O (run_n.sh, run_o.sh): M's run on SEED (runs/l1rep3m_sSEED,
+# epoch 1500, its replay buffer; m_stage makes it again when missing) copied to runs/l1rep3TAG_sSEED (TAG without its
+# underscore) and resumed to epoch 2000 with the arguments, then the export $D/student_l1_rep3TAG_sSEED.pt, its log,
+# the report cells and seed_evals; each step skipped when its file exists
+resume_m() {
+  local X=$1 S=$2 P R
+  shift 2
+  P=$D/student_l1_rep3${X}_s$S.pt
+  R=runs/l1rep3${X#_}_s$S
+  if [ ! -f $D/student_cells_rep3${X}_s$S.json ]; then
+    if [ ! -d $R ]; then
+      [ -f runs/l1rep3m_s$S/checkpoint.pt ] || m_stage $S || return 1
+      cp -r runs/l1rep3m_s$S $R.tmp && mv $R.tmp $R || return 1
+    fi
+    unicross distill --resume --out $R --epochs 2000 "$@" > $R.log 2>&1 || return 1
+    unicross export $R --out $P || return 1
+    cp $R/metrics.jsonl $D/metrics_rep3${X}_s$S.jsonl
+    python docs/runs/student_ft_1202b/seed_cells.py $P $D/student_cells_rep3${X}_s$S.json \
+      > runs/cells_l1rep3${X#_}_s$S.log 2>&1 || return 1
+  fi
+  seed_evals $X $S
+}

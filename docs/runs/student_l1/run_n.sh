@@ -8,19 +8,5 @@ set -x
 cd "$(dirname "$0")/../../.."
 source .venv/bin/activate
 source docs/runs/student_l1/common.sh
-S=$1
-P=$D/student_l1_rep3_n_s$S.pt
-R=runs/l1rep3n_s$S
-if [ ! -f $D/student_cells_rep3_n_s$S.json ]; then
-  if [ ! -d $R ]; then
-    [ -f runs/l1rep3m_s$S/checkpoint.pt ] || m_stage $S || exit 1  # a fresh checkout: M's run made again
-    cp -r runs/l1rep3m_s$S $R.tmp && mv $R.tmp $R || exit 1
-  fi
-  unicross distill --resume --out $R --epochs 2000 --set optim.lr=3.0e-5 > $R.log 2>&1 || exit 1
-  unicross export $R --out $P || exit 1
-  cp $R/metrics.jsonl $D/metrics_rep3_n_s$S.jsonl
-  python docs/runs/student_ft_1202b/seed_cells.py $P $D/student_cells_rep3_n_s$S.json > runs/cells_l1rep3n_s$S.log 2>&1 \
-    || exit 1
-fi
-seed_evals _n $S || exit 1
+resume_m _n $1 --set optim.lr=3.0e-5 || exit 1
 echo DONE
