@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# rule.txt steps 1-4 for one axis AX (x-, x+ or y+): searches A (the opposite axis's gaits run backwards) and B (the
+# rule.txt steps 1-4 for one axis AX (x-, x+ or y+; z+ and y- by rule2.txt, whose step 4 is heldout480.sh): searches A (the opposite axis's gaits run backwards) and B (the
 # axis's own), the second round from the better, the candidate (rotate_zm_it12/pick.py), its clone (seed 0) and the
 # shipped expert on the same 120 held-out trials. Re-running skips what exists. ~35-45 min + ~10 on 2 cores.
 #   bash docs/runs/rotate_axes_it12/run.sh x-
@@ -13,7 +13,13 @@ case $AX in
   x+) A=(rotate_x-_hold rotate_x-_hold2 rotate_x-_sampled); B=(rotate_x+_hold rotate_x+_sampled) ;;
   y+) A=(rotate_y-_hold rotate_y-_hold2 rotate_y-_phase rotate_y-_nostop)
       B=(rotate_y+_hold rotate_y+_hold2 rotate_y+_phase rotate_y+_reversed) ;;
-  *) echo "axis must be x-, x+ or y+" >&2; exit 2 ;;
+  z+) A=(rotate_z-_hold rotate_z-_hold2 rotate_z-_reversed rotate_z-_sampled
+         ../rotate_zm_it12/rotate_z-_it12_A ../rotate_zm_it12/rotate_z-_it12_B ../rotate_zm_it12/rotate_z-_it12_2)
+      B=(rotate_z+_hold rotate_z+_hold2 rotate_z+_sampled) ;;              # rule2.txt
+  y-) A=(rotate_y+_hold rotate_y+_hold2 rotate_y+_phase rotate_y+_reversed
+         ../rotate_axes_it12/y+/rotate_y+_it12_A ../rotate_axes_it12/y+/rotate_y+_it12_B ../rotate_axes_it12/y+/rotate_y+_it12_2)
+      B=(rotate_y-_hold rotate_y-_hold2 rotate_y-_phase rotate_y-_nostop) ;;  # rule2.txt
+  *) echo "axis must be x-, x+, y+ (rule.txt), z+ or y- (rule2.txt)" >&2; exit 2 ;;
 esac
 mkdir -p $D runs/gait runs/clone
 R=runs/gait/rotate_${AX}_it12
