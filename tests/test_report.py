@@ -177,7 +177,7 @@ def test_a_checkpoint_on_top_of_a_gait_is_named_so_in_the_tables(tmp_path):
     from unicross.report import policy_label
     from unicross.rl.policy_io import read_torch_file, resolve_checkpoint
     assert policy_label("allegro/grasp") == "allegro/grasp"
-    ck = read_torch_file(resolve_checkpoint("allegro/rotate_z+"), "checkpoint")
+    ck = read_torch_file(resolve_checkpoint("allegro/rotate_y-"), "checkpoint")
     clone_of = ck.pop("clone_of")
     torch.save(ck, tmp_path / "plain.pt")
     assert policy_label(str(tmp_path / "plain.pt")) == str(tmp_path / "plain.pt")
@@ -185,9 +185,9 @@ def test_a_checkpoint_on_top_of_a_gait_is_named_so_in_the_tables(tmp_path):
     torch.save(ck, tmp_path / "r.pt")
     assert policy_label(str(tmp_path / "r.pt")) == f"{tmp_path / 'r.pt'} (PPO on top of gait:allegro/rotate_y-)"
     # a network cloned from a gait (benchmarks/gait_clone.py records its gait) is not called a PPO expert
-    # (since 2026-12-01 the shipped z+ clone is of the gait run without its stop: its label says so)
-    assert clone_of == "allegro/rotate_z+,tracking=phase,lookahead=1.5,stop=0"
-    assert policy_label("allegro/rotate_z+") == f"allegro/rotate_z+ (DAgger clone of gait:{clone_of}, not PPO)"
+    # (since 2026-12-01 the shipped y- clone is of the gait run without its stop: its label says so)
+    assert clone_of == "allegro/rotate_y-,stop=0"
+    assert policy_label("allegro/rotate_y-") == f"allegro/rotate_y- (DAgger clone of gait:{clone_of}, not PPO)"
     # PPO started from such a clone (the trainer records model.init_policy's clone_of as started_from)
     ck.pop("config")
     ck["started_from"] = dict(policy="runs/clone/policy.pt", clone_of=clone_of)
