@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# rule.txt steps 1-4 for one axis AX (x-, x+ or y+; z+ and y- by rule2.txt, whose step 4 is heldout480.sh): searches A (the opposite axis's gaits run backwards) and B (the
+# rule.txt steps 1-4 for one axis AX (x-, x+ or y+; z+ and y- by rule2.txt, whose step 4 is `confirm.sh AX 480`):
+# searches A (the opposite axis's gaits run backwards) and B (the
 # axis's own), the second round from the better, the candidate (rotate_zm_it12/pick.py), its clone (seed 0) and the
 # shipped expert on the same 120 held-out trials. Re-running skips what exists. ~35-45 min + ~10 on 2 cores.
 #   bash docs/runs/rotate_axes_it12/run.sh x-
