@@ -1,6 +1,7 @@
 """DAgger: the trainer refuses to start without every expert; a real tiny run lowers the
 student's action MSE to the experts on held-out states of every mode."""
 import copy
+import shutil
 
 import pytest
 import torch
@@ -116,6 +117,43 @@ def test_dagger_resume(tmp_path, experts, capsys):
     assert "resumed with optim.lr=0.0001 (was 0.0003)" in capsys.readouterr().out
     r.train(epochs=1)
     assert r.epoch == 3
+    r.close()
+
+
+def test_a_resume_with_a_changed_teacher_labels_its_rows_again(tmp_path, experts, capsys):
+    """Resumed with another experts folder where only rotate_z+'s teacher differs, the replay buffer's rotate_z+
+    rows carry the new teacher's labels and every other row keeps its own; the same teachers relabel nothing."""
+    cfg = _tiny_cfg(num_envs=1, epochs=10)  # 40 steps: five episodes of 8 steps, both modes among them
+    cfg["env"].update(modes=["grasp", "rotate_z+"], reconfiguration_freq=1)  # a new (object, mode) pair each episode
+    t = DAggerTrainer(tmp_path / "run", experts, overrides=cfg, progress=False)
+    t.train()
+    before = t.rb[:].clone()
+    t.close()
+    zp = F.MODES.index("rotate_z+")
+    assert {0, zp} <= set(before["mode"].tolist())  # both modes' rows are stored
+    other = tmp_path / "experts2"
+    for m in ("grasp", "rotate_z+"):
+        (other / m).mkdir(parents=True)
+    shutil.copy(experts / "grasp" / "checkpoint.pt", other / "grasp" / "checkpoint.pt")  # the same file
+    ck = torch.load(experts / "rotate_z+" / "checkpoint.pt", weights_only=False)
+    g = torch.Generator().manual_seed(0)  # another z+ teacher: the same network with other weights
+    ck["policy"] = {k: v + 0.5 * torch.randn(v.shape, generator=g) if v.is_floating_point() and "weight" in k else v
+                    for k, v in ck["policy"].items()}
+    torch.save(ck, other / "rotate_z+" / "checkpoint.pt")
+    capsys.readouterr()
+    r = DAggerTrainer(tmp_path / "run", other, resume=True, progress=False)
+    assert "other teachers for rotate_z+:" in capsys.readouterr().out
+    after = r.rb[:]
+    z = before["mode"] == zp
+    assert torch.equal(after["expert_action"][~z], before["expert_action"][~z])
+    assert not torch.allclose(after["expert_action"][z], before["expert_action"][z])
+    assert torch.allclose(after["expert_action"][z], r.teachers(before[z].select("hand", "object", "goal")))
+    assert r.state()["expert_digests"]["rotate_z+"] != r.state()["expert_digests"]["grasp"]
+    r.train(epochs=1)
+    r.close()
+    # resumed again with the same teachers: no row is labelled again
+    r = DAggerTrainer(tmp_path / "run", other, resume=True, progress=False)
+    assert "other teachers" not in capsys.readouterr().out
     r.close()
 
 

@@ -20,6 +20,7 @@ MSE and per-mode success rates are logged.
 """
 from __future__ import annotations
 
+import hashlib
 import math
 import os
 import shutil
@@ -53,6 +54,24 @@ def expert_paths(experts_dir, modes=F.MODES) -> Dict[str, Path]:
                                 f"(expected <experts>/<mode>/checkpoint.pt, e.g. from "
                                 f"`unicross train --skill rotate --axis x+ --out {d}/rotate_x+`)")
     return paths
+
+
+def file_digest(path) -> str:
+    """The sha256 of a file's bytes (a teacher's identity in a distillation checkpoint)."""
+    h = hashlib.sha256()
+    with open(path, "rb") as f:
+        for block in iter(lambda: f.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()
+
+
+def changed_teachers(saved: Optional[Dict[str, str]], saved_dir, digests: Dict[str, str], experts_dir) -> list:
+    """The modes whose teacher differs from the one a checkpoint was labelled by: those whose file digest differs
+    from ``saved`` (the checkpoint's ``expert_digests``); a checkpoint written before digests were kept names only
+    its experts folder, so every mode counts as changed when the folder differs and none when it is the same."""
+    if saved is None:
+        return [] if str(saved_dir) == str(experts_dir) else list(digests)
+    return [m for m, d in digests.items() if saved.get(m) != d]
 
 
 def walked_modes(modes: Sequence[str], repeats: Optional[Dict[str, int]]) -> list:
@@ -198,6 +217,7 @@ class DAggerTrainer(Runner):
         self.experts_dir = str(experts_dir)
         modes = cfg["env"]["modes"] or list(F.MODES)
         paths = expert_paths(experts_dir, modes)  # refuses to start without every expert
+        self.expert_digests = {m: file_digest(p) for m, p in paths.items()}
         ec = cfg["env"]
         kw = dict(randomize=ec["randomize"], modes=walked_modes(modes, ec.get("mode_repeats")),
                   reconfiguration_freq=ec["reconfiguration_freq"] if ec["backend"] == "physx_cpu" else 0,
@@ -263,7 +283,8 @@ class DAggerTrainer(Runner):
     def state(self) -> dict:
         learner = dict(policy=self.student.state_dict(), optim=self.optim.state_dict())
         return dict(**self.runner_state(), **(on_cpu(learner) if self._elsewhere else learner),
-                    epoch=self.epoch, frames=self.frames, experts_dir=self.experts_dir, skill="multi", axis=None,
+                    epoch=self.epoch, frames=self.frames, experts_dir=self.experts_dir,
+                    expert_digests=self.expert_digests, skill="multi", axis=None,
                     hand=self.teachers.hand, obs_dims=self.dims, n_act=self.n_act, modes=list(F.MODES),
                     distilled_modes=list(self.teachers.modes), env_kwargs=self.env_kwargs)
 
@@ -298,6 +319,32 @@ class DAggerTrainer(Runner):
         replay = self.run_dir / ck.get("replay_dir", "replay")  # "replay": checkpoints before named buffers
         if ck.get("replay_dir", "replay") and replay.exists():
             self.rb.loads(replay)
+            changed = changed_teachers(ck.get("expert_digests"), ck.get("experts_dir"), self.expert_digests,
+                                       self.experts_dir)
+            if changed:
+                n = self.relabel(changed)
+                print(f"[unicross] resumed with other teachers for {', '.join(changed)}: {n} stored rows labelled "
+                      "again by them")
+
+    @torch.no_grad()
+    def relabel(self, modes: Sequence[str], chunk: int = 65536) -> int:
+        """Labels the replay buffer's rows of ``modes`` again by the current teachers (a resumed run whose
+        teachers changed: DAgger fits the labels of the teachers it distils now, not of those that labelled the
+        buffer). Returns the number of rows labelled."""
+        storage, n, done = self.rb.storage, len(self.rb), 0
+        wanted = torch.tensor([F.MODES.index(m) for m in modes])
+        for start in range(0, n, chunk):
+            rows = torch.arange(start, min(start + chunk, n))
+            td = storage.get(rows)
+            sel = torch.isin(td["mode"], wanted.to(td["mode"].device))
+            if not bool(sel.any()):
+                continue
+            sub = td[sel]
+            labels = self.teachers(sub.select(*OBS_KEYS).to(self.device))
+            sub["expert_action"] = labels.to(sub.device)
+            storage.set(rows[sel.cpu()], sub, set_cursor=False)
+            done += int(sel.sum())
+        return done
 
     # ------------------------------------------------------------------ one epoch
     @torch.no_grad()
