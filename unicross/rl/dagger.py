@@ -323,8 +323,9 @@ class DAggerTrainer(Runner):
                                        self.experts_dir)
             if changed:
                 n = self.relabel(changed)
-                print(f"[unicross] resumed with other teachers for {', '.join(changed)}: {n} stored rows labelled "
-                      "again by them")
+                which = (", ".join(changed) if ck.get("expert_digests") is not None else
+                         f"every mode (a checkpoint without teacher digests, labelled by {ck.get('experts_dir')})")
+                print(f"[unicross] resumed with other teachers for {which}: {n} stored rows labelled again by them")
 
     @torch.no_grad()
     def relabel(self, modes: Sequence[str], chunk: int = 65536) -> int:
