@@ -20,7 +20,8 @@ rotate_seeds_experts_m.json; a missed z- or y+ bar is excused (M3b) when every o
 runs resumed to epoch 2000 at lr 3e-5 (tag _n); O as M: M's three runs resumed to epoch 2000 with the grasp rows
 weighted 3 (tag _o); P as O: O's three runs resumed to epoch 2500 with the z+ expert shipped at 564f969 (tag _p), its
 z+ bar from that expert (rotate_seeds_experts_p.json), the long horizon and the excusable z+ cell (P3) against O's
-seed 16 (shipped by O). The last line is PASSED or FAILED (ship.py reads it).
+seed 16 (shipped by O); Q as P on new DAgger seeds (tag _q), its translate cells pooled over evaluation seeds 0-3
+against the experts' (translate_seeds_experts.json) as the rotate cells. The last line is PASSED or FAILED (ship.py reads it).
 """
 import importlib.util
 import json
@@ -33,8 +34,9 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 # the export's tag, the training seeds, whether the long horizon pools evaluation seeds 0-3
 SCREENS = {"I": ("_w10ship", (4, 5, 6), False), "J": ("_w5ship", (7, 8, 9), False), "K": ("_w5ship", (10, 11, 12), True),
            "L": ("_chz", (13, 14, 15), True), "M": ("_m", (16, 17, 18), True), "N": ("_n", (16, 17, 18), True),
-           "O": ("_o", (16, 17, 18), True), "P": ("_p", (16, 17, 18), True)}
-M_LIKE = ("M", "N", "O", "P")  # the screens judged with M's references (M1, M3b); P with its own beside them
+           "O": ("_o", (16, 17, 18), True), "P": ("_p", (16, 17, 18), True),
+           "Q": ("_q", (16, 17, 18), True)}
+M_LIKE = ("M", "N", "O", "P", "Q")  # the screens judged with M's references (M1, M3b); P and Q with their own beside them
 NEW_EXPERTS = "rotate_seeds_experts_m.json"  # M1: the z- and y+ experts shipped since K
 L_REF_ROTATE = "rotate_seeds_rep3_w5ship_s10.json"  # M3b: the shipped student's rotate cells under seeds 1-3
 # L's long-horizon reference: K's seed 10 (shipped by K), its evaluation-seed-0 cells and seeds 1-3
@@ -44,6 +46,8 @@ L_REF = ("student_cells_rep3_w5ship_s10.json", "chain_seeds_rep3_w5ship_s10.json
 P_EXPERTS = "rotate_seeds_experts_p.json"
 O_REF = ("student_cells_rep3_o_s16.json", "chain_seeds_rep3_o_s16.json")
 O_REF_ROTATE = "rotate_seeds_rep3_o_s16.json"
+# Q1: the translate experts over evaluation seeds 0-3; Q's translate cells pool seeds 0-3 as the rotate cells
+Q_TRANSLATE = "translate_seeds_experts.json"
 GAIN = "Gr. + Re. + Trans."  # L3: the chain that must gain
 EVAL_SEEDS = ("0", "1", "2", "3")
 spec = importlib.util.spec_from_file_location("judge3", os.path.join(HERE, "..", "student_xp_drift", "judge3.py"))
@@ -74,11 +78,12 @@ if __name__ == "__main__":
     cells_files = [os.path.join(HERE, f"student_cells_rep3{tag}_s{s}.json") for s in seeds]
     rot_files = [os.path.join(HERE, f"rotate_seeds_rep3{tag}_s{s}.json") for s in seeds]
     chain_files = [os.path.join(HERE, f"chain_seeds_rep3{tag}_s{s}.json") for s in seeds] if chain_seeds else []
-    ref_cells, ref_rotate = (O_REF, O_REF_ROTATE) if screen == "P" else (L_REF, L_REF_ROTATE)
+    ref_cells, ref_rotate = (O_REF, O_REF_ROTATE) if screen in ("P", "Q") else (L_REF, L_REF_ROTATE)
     refs = list(ref_cells) if screen in ("L", *M_LIKE) else ["chain_seeds_shipped.json"]
     chain_files += [os.path.join(HERE, f) for f in refs] if chain_seeds else []
     extra = [os.path.join(HERE, f) for f in (NEW_EXPERTS, ref_rotate)] if screen in M_LIKE else []
-    extra += [os.path.join(HERE, P_EXPERTS)] if screen == "P" else []
+    extra += [os.path.join(HERE, P_EXPERTS)] if screen in ("P", "Q") else []
+    extra += [os.path.join(HERE, Q_TRANSLATE)] if screen == "Q" else []
     missing = [f for f in cells_files + rot_files + chain_files + extra if not os.path.exists(f)]
     if missing:
         sys.exit("missing: " + ", ".join(missing))
@@ -86,11 +91,17 @@ if __name__ == "__main__":
     new_experts = json.load(open(os.path.join(HERE, NEW_EXPERTS)))["cells"] if screen in M_LIKE else {}
     experts.update(new_experts)
     excused_modes = set(new_experts)  # M3b: the cells a miss of which may be excused by a gain
-    if screen == "P":
+    if screen in ("P", "Q"):
         replaced = json.load(open(os.path.join(HERE, P_EXPERTS)))["cells"]
         experts.update(replaced)
         new_experts = {**new_experts, **replaced}
         excused_modes = set(replaced)
+    over_four = ("rotate_",)  # the cells pooled over evaluation seeds 0-3 against the experts' four seeds
+    if screen == "Q":
+        translate = json.load(open(os.path.join(HERE, Q_TRANSLATE)))["cells"]
+        experts.update(translate)
+        new_experts = {**new_experts, **translate}
+        over_four += ("translate_",)
     excusable = {}  # M3b: mode -> (pooled lower bound, the shipped student's rate over seeds 0-3)
     pool, cells = judge3.pooled(cells_files)
     rots = [json.load(open(f))["cells"] for f in rot_files]
@@ -108,7 +119,7 @@ if __name__ == "__main__":
     print("| cell | " + " | ".join(f"seed {s}" for s in seeds) + " | student pooled [95% CI] | expert [95% CI] | bar | |")
     print("|---|---|---|---|---|---|---|---|")
     for name, (k, n) in pool.items():
-        if name.startswith("rotate_"):
+        if name.startswith(over_four):
             ex = experts[name]
             measured = 100 * ex["0"]["successes"] / ex["0"]["n"]
             if measured != judge3.EXPERT[name] and name not in new_experts:
