@@ -118,3 +118,36 @@ resume_m() {
   fi
   seed_evals $X $S
 }
+
+# resume_o TAG SEED MODES [distill arguments]: screens P and Q (run_p.sh, run_q.sh): O's run on SEED (runs/l1rep3o_sSEED,
+# epoch 2000, its replay buffer; run_o.sh makes it again when missing) copied to runs/l1rep3TAG_sSEED (TAG without its
+# underscore) and resumed to epoch 2500 with runs/experts1207p (the experts of 723f266 with the rotate z+ expert of
+# 564f969; the resume labels the buffer again by them) and O's arguments plus the given ones, then the export
+# $D/student_l1_rep3TAG_sSEED.pt, its log, the report cells, rotate_seeds.py on MODES ("" for its six rotate modes)
+# and chain_seeds.py under evaluation seeds 1-3; each step skipped when its file exists
+resume_o() {
+  local X=$1 S=$2 M=$3 P R
+  shift 3
+  P=$D/student_l1_rep3${X}_s$S.pt
+  R=runs/l1rep3${X#_}_s$S
+  experts_at 723f266 runs/experts1207p || return 1
+  if ! cmp -s runs/experts1207p/rotate_z+/checkpoint.pt <(git show 564f969:unicross/checkpoints/allegro/rotate_z+.pt); then
+    git show 564f969:unicross/checkpoints/allegro/rotate_z+.pt > runs/experts1207p/rotate_z+/checkpoint.pt || return 1
+  fi
+  if [ ! -f $D/student_cells_rep3${X}_s$S.json ]; then
+    if [ ! -d $R ]; then
+      [ -f runs/l1rep3o_s$S/checkpoint.pt ] || bash $D/run_o.sh $S || return 1
+      cp -r runs/l1rep3o_s$S $R.tmp && mv $R.tmp $R || return 1
+    fi
+    unicross distill --resume --experts runs/experts1207p --out $R --epochs 2500 \
+      --set 'optim.mode_weights={rotate_x+: 5, grasp: 3}' "$@" > $R.log 2>&1 || return 1
+    unicross export $R --out $P || return 1
+    cp $R/metrics.jsonl $D/metrics_rep3${X}_s$S.jsonl
+    python docs/runs/student_ft_1202b/seed_cells.py $P $D/student_cells_rep3${X}_s$S.json \
+      > runs/cells_l1rep3${X#_}_s$S.log 2>&1 || return 1
+  fi
+  [ -f $D/rotate_seeds_rep3${X}_s$S.json ] || python $D/rotate_seeds.py $D/rotate_seeds_rep3${X}_s$S.json $P \
+    ${M:+--modes $M} > runs/rotseeds_l1rep3${X#_}_s$S.log 2>&1 || return 1
+  [ -f $D/chain_seeds_rep3${X}_s$S.json ] || python $D/chain_seeds.py $D/chain_seeds_rep3${X}_s$S.json $P \
+    > runs/chainseeds_l1rep3${X#_}_s$S.log 2>&1
+}

@@ -9,22 +9,5 @@ set -x
 cd "$(dirname "$0")/../../.."
 source .venv/bin/activate
 source docs/runs/student_l1/common.sh
-S=$1 P=docs/runs/student_l1/student_l1_rep3_p_s$1.pt R=runs/l1rep3p_s$1
-experts_at 723f266 runs/experts1207p || exit 1
-if ! cmp -s runs/experts1207p/rotate_z+/checkpoint.pt <(git show 564f969:unicross/checkpoints/allegro/rotate_z+.pt); then
-  git show 564f969:unicross/checkpoints/allegro/rotate_z+.pt > runs/experts1207p/rotate_z+/checkpoint.pt || exit 1
-fi
-if [ ! -f docs/runs/student_l1/student_cells_rep3_p_s$S.json ]; then
-  if [ ! -d $R ]; then
-    [ -f runs/l1rep3o_s$S/checkpoint.pt ] || bash docs/runs/student_l1/run_o.sh $S || exit 1
-    cp -r runs/l1rep3o_s$S $R.tmp && mv $R.tmp $R || exit 1
-  fi
-  unicross distill --resume --experts runs/experts1207p --out $R --epochs 2500 \
-    --set 'optim.mode_weights={rotate_x+: 5, grasp: 3}' > $R.log 2>&1 || exit 1
-  unicross export $R --out $P || exit 1
-  cp $R/metrics.jsonl docs/runs/student_l1/metrics_rep3_p_s$S.jsonl
-  python docs/runs/student_ft_1202b/seed_cells.py $P docs/runs/student_l1/student_cells_rep3_p_s$S.json \
-    > runs/cells_l1rep3p_s$S.log 2>&1 || exit 1
-fi
-seed_evals _p $S || exit 1
+resume_o _p $1 "" || exit 1
 echo DONE
