@@ -9,7 +9,8 @@ rotate cells over evaluation seeds 0-3; J: I's judge, x+ weight 5, seeds 7-9; K:
 L: K's with env.chain_repeats={rotate_x+: 1, translate_z-: 3} on seeds 13-15, from K's initial student, tag _chz; M: K's
 stage from K's initial student with the experts shipped at 723f266 (new z- and y+), seeds 16-18, tag _m; O: M's runs
 resumed to epoch 2000 with the grasp rows weighted 3, tag _o: ``RESUMED``; P: O's runs resumed to epoch 2500 with the
-z+ expert of 564f969, tag _p: ``CONTINUED``, its record appended to the shipped one's). It refuses to
+z+ expert of 564f969, tag _p: ``CONTINUED``, its record appended to the shipped one's; Q: P's on DAgger seeds 116-118,
+tag _q, ``CONTINUED``). It refuses to
 write unless the screen's judge output (``judge_<screen>.txt``, e.g. judge_h.txt) ends in PASSED; ``--dry`` prints the new sidecar without writing anything. The stage command in the sidecar is
 common.sh's ``stage`` with ``ship_screen``'s arguments, as run_g.sh / run_h.sh call it.
 """
@@ -31,7 +32,8 @@ SCREENS = {"G": (10, (1, 2, 3), JUDGE3), "H": (15, (1, 2, 3), JUDGE3),
            "L": (5, (13, 14, 15), f"python {D}/judge_i.py L   # also reads {D}/rotate_seeds_*.json, {D}/chain_seeds_*.json"),
            "M": (5, (16, 17, 18), f"python {D}/judge_i.py M   # also reads {D}/rotate_seeds_*.json, {D}/chain_seeds_*.json"),
            "O": (5, (16, 17, 18), f"python {D}/judge_i.py O   # also reads {D}/rotate_seeds_*.json, {D}/chain_seeds_*.json"),
-           "P": (5, (16, 17, 18), f"python {D}/judge_i.py P   # also reads {D}/rotate_seeds_*.json, {D}/chain_seeds_*.json")}
+           "P": (5, (16, 17, 18), f"python {D}/judge_i.py P   # also reads {D}/rotate_seeds_*.json, {D}/chain_seeds_*.json"),
+           "Q": (5, (16, 17, 18), f"python {D}/judge_i.py Q   # also reads {D}/rotate_seeds_*.json, {D}/chain_seeds_*.json")}
 # screens that resume another screen's runs (run_o.sh): the screen whose stage they resume, their tag, the epochs they
 # run to and the resume's arguments
 RESUMED = {"O": ("M", "_o", 2000, "--set 'optim.mode_weights={rotate_x+: 5, grasp: 3}'")}
@@ -52,13 +54,21 @@ OTHER_TEACHERS = {"M": ("runs/experts1207", "723f266", "the ten Allegro experts 
                         "iterations, 63rd and 64th sessions)")}
 # screens that resume the shipped student's own run with other teachers (run_p.sh): the screen shipped, its tag, the
 # new screen's tag, the epochs, the experts folder, how it is made, the teachers' description and the resume's arguments
+# (a template of the seed {s}: braces doubled)
 CONTINUED = {"P": ("O", "_o", "_p", 2500, "runs/experts1207p",
                    "for m in {modes}; do mkdir -p runs/experts1207p/$m; git show 723f266:unicross/checkpoints/allegro/"
                    "$m.pt > runs/experts1207p/$m/checkpoint.pt; done; git show 564f969:unicross/checkpoints/allegro/"
                    "rotate_z+.pt > runs/experts1207p/rotate_z+/checkpoint.pt   # {D}/run_p.sh",
                    "the ten Allegro experts shipped at commit 564f969 (those of 723f266 but rotate z+, the clone of a "
                    "z+ gait searched under 12 solver iterations, 68th session)",
-                   "--set 'optim.mode_weights={rotate_x+: 5, grasp: 3}'")}
+                   "--set 'optim.mode_weights={{rotate_x+: 5, grasp: 3}}'"),
+             "Q": ("O", "_o", "_q", 2500, "runs/experts1207p",
+                   "for m in {modes}; do mkdir -p runs/experts1207p/$m; git show 723f266:unicross/checkpoints/allegro/"
+                   "$m.pt > runs/experts1207p/$m/checkpoint.pt; done; git show 564f969:unicross/checkpoints/allegro/"
+                   "rotate_z+.pt > runs/experts1207p/rotate_z+/checkpoint.pt   # {D}/run_q.sh",
+                   "the ten Allegro experts shipped at commit 564f969 (those of 723f266 but rotate z+, the clone of a "
+                   "z+ gait searched under 12 solver iterations, 68th session)",
+                   "--set 'optim.mode_weights={{rotate_x+: 5, grasp: 3}}' --set seed=1{s}")}
 MODES = "grasp relocate rotate_x+ rotate_x- rotate_y+ rotate_y- rotate_z+ rotate_z- translate_z+ translate_z-"
 
 
@@ -102,7 +112,7 @@ def continued_record(name, old, ship_seed, others, judge_cmd):
         stage_frames=frames, stage_wall_s=round(wall_s, 1),
         frames_note=f"frames and train_wall_s count every stage from the first DAgger run: the student this resume "
                     f"continued ({old['frames']} frames, {old['train_wall_s']} s; its own frames_note under replaced) "
-                    f"and this resume (stage_frames, stage_wall_s: to epoch {epochs} with {resume_args}, on the ten "
+                    f"and this resume (stage_frames, stage_wall_s: to epoch {epochs} with {resume_args.format(s=ship_seed)}, on the ten "
                     f"experts of {experts})",
         rule=f"{D}/rule.txt screen {name} (three seeds pooled, {judge_cmd.split()[1]}; seed {ship_seed} named "
              "before the runs)",
