@@ -55,20 +55,16 @@ OTHER_TEACHERS = {"M": ("runs/experts1207", "723f266", "the ten Allegro experts 
 # screens that resume the shipped student's own run with other teachers (run_p.sh): the screen shipped, its tag, the
 # new screen's tag, the epochs, the experts folder, how it is made, the teachers' description and the resume's arguments
 # (a template of the seed {s}: braces doubled)
-CONTINUED = {"P": ("O", "_o", "_p", 2500, "runs/experts1207p",
-                   "for m in {modes}; do mkdir -p runs/experts1207p/$m; git show 723f266:unicross/checkpoints/allegro/"
-                   "$m.pt > runs/experts1207p/$m/checkpoint.pt; done; git show 564f969:unicross/checkpoints/allegro/"
-                   "rotate_z+.pt > runs/experts1207p/rotate_z+/checkpoint.pt   # {D}/run_p.sh",
-                   "the ten Allegro experts shipped at commit 564f969 (those of 723f266 but rotate z+, the clone of a "
-                   "z+ gait searched under 12 solver iterations, 68th session)",
-                   "--set 'optim.mode_weights={{rotate_x+: 5, grasp: 3}}'"),
-             "Q": ("O", "_o", "_q", 2500, "runs/experts1207p",
-                   "for m in {modes}; do mkdir -p runs/experts1207p/$m; git show 723f266:unicross/checkpoints/allegro/"
-                   "$m.pt > runs/experts1207p/$m/checkpoint.pt; done; git show 564f969:unicross/checkpoints/allegro/"
-                   "rotate_z+.pt > runs/experts1207p/rotate_z+/checkpoint.pt   # {D}/run_q.sh",
-                   "the ten Allegro experts shipped at commit 564f969 (those of 723f266 but rotate z+, the clone of a "
-                   "z+ gait searched under 12 solver iterations, 68th session)",
-                   "--set 'optim.mode_weights={{rotate_x+: 5, grasp: 3}}' --set seed=1{s}")}
+# P and Q (common.sh resume_o) share the experts folder, how it is made and the teachers; Q adds the DAgger seed
+EXPERTS_1207P = ("runs/experts1207p",
+                 "for m in {modes}; do mkdir -p runs/experts1207p/$m; git show 723f266:unicross/checkpoints/allegro/"
+                 "$m.pt > runs/experts1207p/$m/checkpoint.pt; done; git show 564f969:unicross/checkpoints/allegro/"
+                 "rotate_z+.pt > runs/experts1207p/rotate_z+/checkpoint.pt   # {D}/run_{screen}.sh",
+                 "the ten Allegro experts shipped at commit 564f969 (those of 723f266 but rotate z+, the clone of a "
+                 "z+ gait searched under 12 solver iterations, 68th session)")
+O_RESUME = "--set 'optim.mode_weights={{rotate_x+: 5, grasp: 3}}'"
+CONTINUED = {"P": ("O", "_o", "_p", 2500, *EXPERTS_1207P, O_RESUME),
+             "Q": ("O", "_o", "_q", 2500, *EXPERTS_1207P, O_RESUME + " --set seed=1{s}")}
 MODES = "grasp relocate rotate_x+ rotate_x- rotate_y+ rotate_y- rotate_z+ rotate_z- translate_z+ translate_z-"
 
 
@@ -88,7 +84,7 @@ def continued_record(name, old, ship_seed, others, judge_cmd):
     frames = ck["frames"] - was["frames"]
     resume = f"unicross distill --resume --experts {experts} --out {run} --epochs {epochs} {resume_args}"
     commands = old["commands"] + [
-        make_experts.format(modes=MODES, D=D),
+        make_experts.format(modes=MODES, D=D, screen=name.lower()),
         f"cp -r {prev.format(s=ship_seed)} {run.format(s=ship_seed)}   # {D}/run_{name.lower()}.sh",
         resume.format(s=ship_seed) + f"   # commit {ck['git_commit'][:7]}, {wall_s / 60:.0f} min on 2 cores (rule.txt "
         f"screen {name}: the shipped student's run resumed with its replay buffer, labelled again by the new teachers)",
