@@ -1,0 +1,102 @@
+"""Judge rule.txt: the z- clone from chain-aware starts against the shipped translate z- expert.
+
+    python docs/runs/translate_zm_chain/judge.py [RUNS]   # RUNS: runs/zmchain (default)
+
+(a) Gr. + Re. + Trans. overall of the ten experts chained, candidate against shipped, pooled over evaluation seeds
+0-3 and paired by (seed, object, trial): the gain must be >= 3 points with the paired 95% interval above 0.
+(b) the report's translate z- test cell over the same four seeds: candidate >= shipped - 3 points.
+Also prints the chained translate z- phase (trials whose relocation succeeded) and the z+ phase, as diagnosis.
+"""
+import json
+import math
+import sys
+from pathlib import Path
+
+RUNS = Path(sys.argv[1] if len(sys.argv) > 1 else "runs/zmchain")
+SEEDS = (0, 1, 2, 3)
+TRANS = "Gr. + Re. + Trans."
+
+
+def wilson(k: int, n: int, z: float = 1.96):
+    if n == 0:
+        return float("nan"), float("nan")
+    p = k / n
+    d = 1 + z * z / n
+    c = (p + z * z / (2 * n)) / d
+    h = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / d
+    return 100 * (c - h), 100 * (c + h)
+
+
+def paired(a, b, z: float = 1.96):
+    """Mean difference b - a of paired 0/1 outcomes (points) and its Wald 95% interval."""
+    n = len(a)
+    d = [float(y) - float(x) for x, y in zip(a, b)]
+    m = sum(d) / n
+    var = sum((x - m) ** 2 for x in d) / (n - 1)
+    h = z * math.sqrt(var / n)
+    return 100 * m, 100 * (m - h), 100 * (m + h)
+
+
+def chains(who: str):
+    out = {}
+    for s in SEEDS:
+        for t in json.loads((RUNS / f"chain_{who}_s{s}.json").read_text())["trials"]:
+            if t["sequence"][-1].startswith("translate"):
+                out[(s, t["object"], t["trial"])] = t
+    return out
+
+
+def cell(who: str):
+    out = {}
+    for s in SEEDS:
+        d = json.loads((RUNS / f"cell_{who}_s{s}.json").read_text())
+        for t in d["trials"]["translate"]:
+            out[(s, t["object"], t["trial"])] = bool(t["success"])
+    return out
+
+
+def line(name, k, n):
+    lo, hi = wilson(k, n)
+    return f"{name}: {k}/{n} = {100 * k / n:.1f}% [{lo:.1f}-{hi:.1f}]"
+
+
+def main() -> int:
+    sh, ca = chains("shipped"), chains("cand")
+    keys = sorted(sh)
+    assert keys == sorted(ca), "the two sides' chains are not the same trials"
+    for k in keys:  # same object, same random direction per trial
+        assert sh[k]["sequence"] == ca[k]["sequence"], k
+    a = [sh[k]["overall"] for k in keys]
+    b = [ca[k]["overall"] for k in keys]
+    print(f"(a) {TRANS} overall, evaluation seeds {SEEDS} (n = {len(keys)} chains)")
+    print("    " + line("shipped", sum(a), len(a)))
+    print("    " + line("candidate", sum(b), len(b)))
+    diff, lo, hi = paired(a, b)
+    disc = (sum(1 for x, y in zip(a, b) if y and not x), sum(1 for x, y in zip(a, b) if x and not y))
+    print(f"    paired difference {diff:+.1f} [{lo:+.1f}, {hi:+.1f}] points (candidate-only / shipped-only successes {disc})")
+    ok_a = diff >= 3 and lo > 0
+    print(f"    bar: >= +3 with the interval above 0: {'MET' if ok_a else 'NOT MET'}")
+    for mode in ("translate_z-", "translate_z+"):
+        for who, d in (("shipped", sh), ("candidate", ca)):
+            ph = [d[k] for k in keys if d[k]["sequence"][-1] == mode and d[k]["phase_success"][1]]
+            ok = sum(1 for t in ph if t["phase_success"][2])
+            drops = sum(1 for t in ph if not t["phase_success"][2] and t["dropped_in_phase"] == 2)
+            print(f"    in-hand {mode} after relocation, {who}: {line('', ok, len(ph))[2:]}; failed by a drop {drops}")
+    cs, cc = cell("shipped"), cell("cand")
+    ck = sorted(cs)
+    assert ck == sorted(cc), "the two sides' cells are not the same trials"
+    ks, kc = sum(cs[k] for k in ck), sum(cc[k] for k in ck)
+    print(f"(b) translate z- test cell, evaluation seeds {SEEDS} (n = {len(ck)})")
+    print("    " + line("shipped", ks, len(ck)))
+    print("    " + line("candidate", kc, len(ck)))
+    d2, lo2, hi2 = paired([cs[k] for k in ck], [cc[k] for k in ck])
+    print(f"    paired difference {d2:+.1f} [{lo2:+.1f}, {hi2:+.1f}] points")
+    ok_b = 100 * kc / len(ck) >= 100 * ks / len(ck) - 3
+    print(f"    bar: candidate >= shipped - 3: {'MET' if ok_b else 'NOT MET'}")
+    verdict = ok_a and ok_b
+    print("SHIP" if verdict else "NOT SHIPPED")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
