@@ -1,12 +1,13 @@
 """Judge rule.txt: the z- clone from chain-aware starts against the shipped translate z- expert.
 
-    python docs/runs/translate_zm_chain/judge.py [RUNS]   # RUNS: runs/zmchain (default)
+    python docs/runs/translate_zm_chain/judge.py [RUNS]   # RUNS: runs/zmchain (default), or this folder's data/
 
 (a) Gr. + Re. + Trans. overall of the ten experts chained, candidate against shipped, pooled over evaluation seeds
 0-3 and paired by (seed, object, trial): the gain must be >= 3 points with the paired 95% interval above 0.
 (b) the report's translate z- test cell over the same four seeds: candidate >= shipped - 3 points.
 Also prints the chained translate z- phase (trials whose relocation succeeded) and the z+ phase, as diagnosis.
 """
+import gzip
 import json
 import math
 import sys
@@ -15,6 +16,12 @@ from pathlib import Path
 RUNS = Path(sys.argv[1] if len(sys.argv) > 1 else "runs/zmchain")
 SEEDS = (0, 1, 2, 3)
 TRANS = "Gr. + Re. + Trans."
+
+
+def load(name: str) -> dict:
+    """RUNS/name, or its gzipped copy RUNS/name.gz (as committed)."""
+    p = RUNS / name
+    return json.loads(p.read_text() if p.exists() else gzip.decompress((RUNS / (name + ".gz")).read_bytes()))
 
 
 def wilson(k: int, n: int, z: float = 1.96):
@@ -40,7 +47,7 @@ def paired(a, b, z: float = 1.96):
 def chains(who: str):
     out = {}
     for s in SEEDS:
-        for t in json.loads((RUNS / f"chain_{who}_s{s}.json").read_text())["trials"]:
+        for t in load(f"chain_{who}_s{s}.json")["trials"]:
             if t["sequence"][-1].startswith("translate"):
                 out[(s, t["object"], t["trial"])] = t
     return out
@@ -49,7 +56,7 @@ def chains(who: str):
 def cell(who: str):
     out = {}
     for s in SEEDS:
-        d = json.loads((RUNS / f"cell_{who}_s{s}.json").read_text())
+        d = load(f"cell_{who}_s{s}.json")
         for t in d["trials"]["translate"]:
             out[(s, t["object"], t["trial"])] = bool(t["success"])
     return out
