@@ -1,21 +1,30 @@
-"""Judge rule.txt: the z- clone from chain-aware starts against the shipped translate z- expert.
+"""Judge a chain-aware clone's rule (this folder's rule.txt, ../rotate_zp_chain/rule.txt) against the shipped expert.
 
-    python docs/runs/translate_zm_chain/judge.py [RUNS]   # RUNS: runs/zmchain (default), or this folder's data/
+    python docs/runs/translate_zm_chain/judge.py [RUNS]    # translate z-; RUNS: runs/zmchain, or this folder's data/
+    python docs/runs/translate_zm_chain/judge.py RUNS --mode rotate_z+ --gain 5    # ../rotate_zp_chain/
 
-(a) Gr. + Re. + Trans. overall of the ten experts chained, candidate against shipped, pooled over evaluation seeds
-0-3 and paired by (seed, object, trial): the gain must be >= 3 points with the paired 95% interval above 0.
-(b) the report's translate z- test cell over the same four seeds: candidate >= shipped - 3 points.
-Also prints the chained translate z- phase (trials whose relocation succeeded) and the z+ phase, as diagnosis.
+(a) the chains of the ten experts (RUNS/chain_{shipped,cand}_sS.json) whose in-hand phase is of the mode's skill,
+overall success, candidate against shipped, pooled over evaluation seeds 0-3 and paired by (seed, object, trial):
+the gain must be >= GAIN points with the paired 95% interval above 0.
+(b) the report's test cell of the mode (RUNS/cell_{shipped,cand}_sS.json) over the same four seeds: candidate >=
+shipped - 3 points.
+Also prints each in-hand mode's phase after a successful relocation, as diagnosis.
 """
 import gzip
+import argparse
 import json
 import math
 import sys
 from pathlib import Path
 
-RUNS = Path(sys.argv[1] if len(sys.argv) > 1 else "runs/zmchain")
+ap = argparse.ArgumentParser()
+ap.add_argument("runs", nargs="?", default="runs/zmchain")
+ap.add_argument("--mode", default="translate_z-", help="the candidate's mode")
+ap.add_argument("--gain", type=float, default=3.0, help="bar (a): the least chain gain, points")
+ARGS = ap.parse_args()
+RUNS = Path(ARGS.runs)
+SKILL = ARGS.mode.split("_")[0]
 SEEDS = (0, 1, 2, 3)
-TRANS = "Gr. + Re. + Trans."
 
 
 def load(name: str) -> dict:
@@ -48,7 +57,7 @@ def chains(who: str):
     out = {}
     for s in SEEDS:
         for t in load(f"chain_{who}_s{s}.json")["trials"]:
-            if t["sequence"][-1].startswith("translate"):
+            if t["sequence"][-1].startswith(SKILL):
                 out[(s, t["object"], t["trial"])] = t
     return out
 
@@ -57,7 +66,7 @@ def cell(who: str):
     out = {}
     for s in SEEDS:
         d = load(f"cell_{who}_s{s}.json")
-        for t in d["trials"]["translate"]:
+        for t in d["trials"][SKILL]:
             out[(s, t["object"], t["trial"])] = bool(t["success"])
     return out
 
@@ -75,15 +84,15 @@ def main() -> int:
         assert sh[k]["sequence"] == ca[k]["sequence"], k
     a = [sh[k]["overall"] for k in keys]
     b = [ca[k]["overall"] for k in keys]
-    print(f"(a) {TRANS} overall, evaluation seeds {SEEDS} (n = {len(keys)} chains)")
+    print(f"(a) chains ending in {SKILL}, overall, evaluation seeds {SEEDS} (n = {len(keys)} chains)")
     print("    " + line("shipped", sum(a), len(a)))
     print("    " + line("candidate", sum(b), len(b)))
     diff, lo, hi = paired(a, b)
     disc = (sum(1 for x, y in zip(a, b) if y and not x), sum(1 for x, y in zip(a, b) if x and not y))
     print(f"    paired difference {diff:+.1f} [{lo:+.1f}, {hi:+.1f}] points (candidate-only / shipped-only successes {disc})")
-    ok_a = diff >= 3 and lo > 0
-    print(f"    bar: >= +3 with the interval above 0: {'MET' if ok_a else 'NOT MET'}")
-    for mode in ("translate_z-", "translate_z+"):
+    ok_a = diff >= ARGS.gain and lo > 0
+    print(f"    bar: >= +{ARGS.gain:g} with the interval above 0: {'MET' if ok_a else 'NOT MET'}")
+    for mode in sorted({sh[k]["sequence"][-1] for k in keys}):
         for who, d in (("shipped", sh), ("candidate", ca)):
             ph = [d[k] for k in keys if d[k]["sequence"][-1] == mode and d[k]["phase_success"][1]]
             ok = sum(1 for t in ph if t["phase_success"][2])
@@ -93,7 +102,7 @@ def main() -> int:
     ck = sorted(cs)
     assert ck == sorted(cc), "the two sides' cells are not the same trials"
     ks, kc = sum(cs[k] for k in ck), sum(cc[k] for k in ck)
-    print(f"(b) translate z- test cell, evaluation seeds {SEEDS} (n = {len(ck)})")
+    print(f"(b) {ARGS.mode} test cell, evaluation seeds {SEEDS} (n = {len(ck)})")
     print("    " + line("shipped", ks, len(ck)))
     print("    " + line("candidate", kc, len(ck)))
     d2, lo2, hi2 = paired([cs[k] for k in ck], [cc[k] for k in ck])
