@@ -2,12 +2,15 @@
 
     python docs/runs/translate_zm_chain/judge.py [RUNS]    # translate z-; RUNS: runs/zmchain, or this folder's data/
     python docs/runs/translate_zm_chain/judge.py RUNS --mode rotate_z+ --gain 5    # ../rotate_zp_chain/
+    python docs/runs/translate_zm_chain/judge.py RUNS --mode translate_z+ --gain 3 --guard    # ../translate_zp_chain/
 
 (a) the chains of the ten experts (RUNS/chain_{shipped,cand}_sS.json) whose in-hand phase is of the mode's skill,
 overall success, candidate against shipped, pooled over evaluation seeds 0-3 and paired by (seed, object, trial):
 the gain must be >= GAIN points with the paired 95% interval above 0.
 (b) the report's test cell of the mode (RUNS/cell_{shipped,cand}_sS.json) over the same four seeds: candidate >=
 shipped - 3 points.
+(c) with --guard: the same cell on unseen objects and with --disturb (RUNS/{unseen,dist}_{shipped,cand}_sS.json): in
+neither is the candidate more than 5 points under the shipped expert with the paired 95% interval below 0.
 Also prints each in-hand mode's phase after a successful relocation, as diagnosis.
 """
 import gzip
@@ -21,6 +24,7 @@ ap = argparse.ArgumentParser()
 ap.add_argument("runs", nargs="?", default="runs/zmchain")
 ap.add_argument("--mode", default="translate_z-", help="the candidate's mode")
 ap.add_argument("--gain", type=float, default=3.0, help="bar (a): the least chain gain, points")
+ap.add_argument("--guard", action="store_true", help="bar (c): the unseen and --disturb cells")
 ARGS = ap.parse_args()
 RUNS = Path(ARGS.runs)
 SKILL = ARGS.mode.split("_")[0]
@@ -62,10 +66,10 @@ def chains(who: str):
     return out
 
 
-def cell(who: str):
+def cell(who: str, setting: str = "cell"):
     out = {}
     for s in SEEDS:
-        d = load(f"cell_{who}_s{s}.json")
+        d = load(f"{setting}_{who}_s{s}.json")
         for t in d["trials"][SKILL]:
             out[(s, t["object"], t["trial"])] = bool(t["success"])
     return out
@@ -109,7 +113,20 @@ def main() -> int:
     print(f"    paired difference {d2:+.1f} [{lo2:+.1f}, {hi2:+.1f}] points")
     ok_b = 100 * kc / len(ck) >= 100 * ks / len(ck) - 3
     print(f"    bar: candidate >= shipped - 3: {'MET' if ok_b else 'NOT MET'}")
-    verdict = ok_a and ok_b
+    ok_c = True
+    if ARGS.guard:
+        for setting, name in (("unseen", "unseen objects"), ("dist", "test objects, --disturb")):
+            gs, gc = cell("shipped", setting), cell("cand", setting)
+            gk = sorted(gs)
+            assert gk == sorted(gc), f"the two sides' {setting} cells are not the same trials"
+            a3, b3 = [gs[k] for k in gk], [gc[k] for k in gk]
+            d3, lo3, hi3 = paired(a3, b3)
+            bad = 100 * (sum(b3) - sum(a3)) / len(gk) < -5 and hi3 < 0
+            ok_c &= not bad
+            print(f"(c) {ARGS.mode}, {name} (n = {len(gk)}): shipped {100 * sum(a3) / len(gk):.1f}%, candidate "
+                  f"{100 * sum(b3) / len(gk):.1f}%, paired {d3:+.1f} [{lo3:+.1f}, {hi3:+.1f}]: "
+                  f"{'NOT MET (over 5 points under, interval below 0)' if bad else 'MET'}")
+    verdict = ok_a and ok_b and ok_c
     print("SHIP" if verdict else "NOT SHIPPED")
     return 0
 
