@@ -25,10 +25,13 @@ ap.add_argument("runs", nargs="?", default="runs/zmchain")
 ap.add_argument("--mode", default="translate_z-", help="the candidate's mode")
 ap.add_argument("--gain", type=float, default=3.0, help="bar (a): the least chain gain, points")
 ap.add_argument("--guard", action="store_true", help="bar (c): the unseen and --disturb cells")
+ap.add_argument("--cand", default="cand", help="the candidate's file tag (RUNS/chain_TAG_sS.json, ...), e.g. cand1 "
+                "for another training seed")
+ap.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2, 3], help="evaluation seeds (default 0-3)")
 ARGS = ap.parse_args()
 RUNS = Path(ARGS.runs)
 SKILL = ARGS.mode.split("_")[0]
-SEEDS = (0, 1, 2, 3)
+SEEDS = tuple(ARGS.seeds)
 
 
 def load(name: str) -> dict:
@@ -81,7 +84,7 @@ def line(name, k, n):
 
 
 def main() -> int:
-    sh, ca = chains("shipped"), chains("cand")
+    sh, ca = chains("shipped"), chains(ARGS.cand)
     keys = sorted(sh)
     assert keys == sorted(ca), "the two sides' chains are not the same trials"
     for k in keys:  # same object, same random direction per trial
@@ -102,7 +105,7 @@ def main() -> int:
             ok = sum(1 for t in ph if t["phase_success"][2])
             drops = sum(1 for t in ph if not t["phase_success"][2] and t["dropped_in_phase"] == 2)
             print(f"    in-hand {mode} after relocation, {who}: {line('', ok, len(ph))[2:]}; failed by a drop {drops}")
-    cs, cc = cell("shipped"), cell("cand")
+    cs, cc = cell("shipped"), cell(ARGS.cand)
     ck = sorted(cs)
     assert ck == sorted(cc), "the two sides' cells are not the same trials"
     ks, kc = sum(cs[k] for k in ck), sum(cc[k] for k in ck)
@@ -116,7 +119,7 @@ def main() -> int:
     ok_c = True
     if ARGS.guard:
         for setting, name in (("unseen", "unseen objects"), ("dist", "test objects, --disturb")):
-            gs, gc = cell("shipped", setting), cell("cand", setting)
+            gs, gc = cell("shipped", setting), cell(ARGS.cand, setting)
             gk = sorted(gs)
             assert gk == sorted(gc), f"the two sides' {setting} cells are not the same trials"
             a3, b3 = [gs[k] for k in gk], [gc[k] for k in gk]
