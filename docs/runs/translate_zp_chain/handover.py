@@ -12,7 +12,6 @@ import json
 import sys
 
 import gymnasium as gym
-import torch
 
 import unicross  # noqa: F401
 from unicross.evaluation import resolve_policy
