@@ -1,5 +1,6 @@
 """Amendment (c) of rule.txt: the candidate against the replaced z+ expert on the unseen and --disturb z+ cells over
-evaluation seeds 0-3, paired by trial. Reverts the ship if either is more than 5 points under with the paired 95%
+evaluation seeds 0-3, paired by trial (`../translate_zm_chain/judge.py --guard` now applies the same bar). Reverts the ship if
+either is more than 5 points under with the paired 95%
 interval below 0.
 
     python docs/runs/rotate_zp_chain/guard.py > docs/runs/rotate_zp_chain/guard.txt

@@ -5,7 +5,7 @@
     python docs/runs/translate_zm_chain/judge.py RUNS --mode translate_z+ --gain 3 --guard    # ../translate_zp_chain/
 
 (a) the chains of the ten experts (RUNS/chain_{shipped,cand}_sS.json) whose in-hand phase is of the mode's skill,
-overall success, candidate against shipped, pooled over evaluation seeds 0-3 and paired by (seed, object, trial):
+overall success, candidate against shipped, pooled over evaluation seeds 0-3 (--seeds) and paired by (seed, object, trial):
 the gain must be >= GAIN points with the paired 95% interval above 0.
 (b) the report's test cell of the mode (RUNS/cell_{shipped,cand}_sS.json) over the same four seeds: candidate >=
 shipped - 3 points.
